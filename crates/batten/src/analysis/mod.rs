@@ -1,0 +1,21 @@
+//! Measurements of curves: signed curvature and its arc-length derivative, radius of
+//! curvature, arc length, energies, inflections, curvature extrema, curvature-comb samples,
+//! Calì's fairness indicators, and the [`FairnessMetrics`] every report carries.
+//!
+//! Everything is generic over the capability traits in [`crate::curve`].
+
+mod arclength;
+mod curvature;
+mod gfi;
+mod metrics;
+
+pub use arclength::{ArcLengthTable, arc_length};
+pub use curvature::{
+    CombSample, curvature_at, curvature_comb, curvature_derivative, radius_of_curvature,
+    signed_curvature, strain_energy, variation_energy,
+};
+pub use gfi::{FairnessIndicators, fairness_indicators};
+pub use metrics::{
+    Displacement, FairnessMetrics, ZERO_REL, analysis_curve, count_sign_changes, displacement,
+    sgn0,
+};

@@ -1,0 +1,212 @@
+//! Fairing methods behind one interface.
+//!
+//! Every method is a pure function of a validated [`PointSeq`] and immutable [`FairOptions`];
+//! it returns the faired points and a [`FairReport`] of what it did (params in, result and
+//! report out, as in faer's `CgParams`/`CgInfo`). The [`fair`] entry point looks the method up
+//! in the registry ([`methods`]), checks the options it was given, runs it, and fills in what
+//! every report has in common: displacements, metrics before and after, whether the tolerance
+//! held, elapsed time.
+//!
+//! Adding a method: implement [`FairMethod`] in a file of its own under `fair/` and list it
+//! in [`methods`].
+
+mod options;
+mod report;
+mod smoothing;
+
+use std::time::Instant;
+
+pub use options::{FairOptions, ParamSpec};
+pub use report::{FairReport, FairStatus, HistoryRow, Move};
+pub use smoothing::Mst;
+
+use crate::analysis::{FairnessMetrics, displacement};
+use crate::error::{Error, Result};
+use crate::geom::{Point, PointSeq, Vec2};
+use crate::spline::BSplineCurve;
+
+/// What a method computed, before the common parts of the report are filled in.
+#[derive(Clone, Debug, Default)]
+pub struct Outcome {
+    /// The faired points: same count and order as the input.
+    pub points: Vec<Point>,
+    /// How the run ended.
+    pub status: FairStatus,
+    /// Iterations (sweeps, moves or passes, as the method documents).
+    pub iterations: usize,
+    /// The individual moves, in the order they were made (for local methods).
+    pub moves: Vec<Move>,
+    /// A per-iteration trace of the method's own measure (for the papers' tables and figures).
+    pub history: Vec<HistoryRow>,
+    /// Parameters as actually used (defaults filled in, values chosen by search).
+    pub parameters: serde_json::Map<String, serde_json::Value>,
+    /// Things the user should know (e.g. why the tolerance could not be met).
+    pub notes: Vec<String>,
+    /// The faired curve as a B-spline, for methods that work on one.
+    pub curve: Option<BSplineCurve>,
+    /// Updated tangents, for methods that carry tangents (Hermite data).
+    pub tangents: Option<Vec<Vec2>>,
+}
+
+/// A fairing method. Implementations are stateless unit structs.
+pub trait FairMethod: Sync {
+    /// The name used on the command line (`--method NAME`).
+    fn name(&self) -> &'static str;
+    /// One line for `batten methods`.
+    fn description(&self) -> &'static str;
+    /// The method parameters it accepts through [`FairOptions::params`], with defaults.
+    fn parameters(&self) -> &'static [ParamSpec];
+    /// Whether it can fair closed curves.
+    fn supports_closed(&self) -> bool;
+    /// Run the method. `input` has passed validation; unknown parameters were rejected.
+    ///
+    /// # Errors
+    /// Whatever makes the method fail (a parameter out of range, degenerate geometry).
+    fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome>;
+}
+
+/// The result of [`fair`]: the faired points and the report.
+#[derive(Clone, Debug)]
+pub struct Faired {
+    /// The faired points, same count and order as the input.
+    pub points: Vec<Point>,
+    /// What was done.
+    pub report: FairReport,
+    /// The faired curve as a B-spline, where the method works on one.
+    pub curve: Option<BSplineCurve>,
+    /// Updated tangents, where the method carries them.
+    pub tangents: Option<Vec<Vec2>>,
+}
+
+static MST: Mst = Mst;
+
+static REGISTRY: &[&dyn FairMethod] = &[&MST];
+
+/// Every registered method, the default first.
+pub fn methods() -> &'static [&'static dyn FairMethod] {
+    REGISTRY
+}
+
+/// The name of the default method: the best the project has.
+pub fn default_method() -> &'static str {
+    REGISTRY[0].name()
+}
+
+/// Look a method up by name.
+///
+/// # Errors
+/// [`Error::UnknownMethod`] listing the known names.
+pub fn method(name: &str) -> Result<&'static dyn FairMethod> {
+    REGISTRY.iter().copied().find(|m| m.name() == name).ok_or_else(|| Error::UnknownMethod {
+        name: name.to_string(),
+        known: REGISTRY.iter().map(|m| m.name()).collect::<Vec<_>>().join(", "),
+    })
+}
+
+/// Check `options` against what `method` accepts: known parameter names, a positive finite
+/// tolerance, closed-curve support.
+///
+/// # Errors
+/// [`Error::UnknownOption`], [`Error::InvalidParameter`], [`Error::ClosedUnsupported`].
+pub fn check_options(method: &dyn FairMethod, input_closed: bool, options: &FairOptions) -> Result<()> {
+    if input_closed && !method.supports_closed() {
+        return Err(Error::ClosedUnsupported { method: method.name().to_string() });
+    }
+    options.validate()?;
+    let specs = method.parameters();
+    for key in options.params.keys() {
+        if !specs.iter().any(|s| s.name == key) {
+            return Err(Error::UnknownOption {
+                method: method.name().to_string(),
+                key: key.clone(),
+                known: if specs.is_empty() {
+                    "none".to_string()
+                } else {
+                    specs.iter().map(|s| s.name).collect::<Vec<_>>().join(", ")
+                },
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Fair `input` with the method called `name`.
+///
+/// # Errors
+/// [`Error::UnknownMethod`], option errors (see [`check_options`]), and the method's own
+/// errors. Not meeting the tolerance is not an error: the report says so in
+/// [`FairReport::tolerance_met`] and [`FairReport::status`].
+pub fn fair(name: &str, input: &PointSeq, options: &FairOptions) -> Result<Faired> {
+    let m = method(name)?;
+    fair_with(m, input, options)
+}
+
+/// As [`fair`], with the method given directly.
+///
+/// # Errors
+/// As [`fair`].
+pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) -> Result<Faired> {
+    check_options(m, input.is_closed(), options)?;
+    let before = FairnessMetrics::of_seq(input)?;
+    let start = Instant::now();
+    let outcome = m.run(input, options)?;
+    let elapsed = start.elapsed();
+    if outcome.points.len() != input.len() {
+        return Err(Error::LengthMismatch {
+            what: "faired points",
+            got: outcome.points.len(),
+            expected: input.len(),
+        });
+    }
+    let faired = input.with_points(outcome.points.clone())?;
+    let after = FairnessMetrics::of_seq(&faired)?;
+    let disp = displacement(input.points(), &outcome.points)?;
+    let tolerance_met = options.tolerance.is_none_or(|d| disp.max <= d);
+    let mut status = outcome.status;
+    let mut notes = outcome.notes;
+    if !tolerance_met {
+        status = FairStatus::ToleranceExceeded;
+        notes.push(format!(
+            "the largest displacement {:.6e} exceeds the tolerance {:.6e}",
+            disp.max,
+            options.tolerance.unwrap_or(f64::NAN)
+        ));
+    }
+    let report = FairReport {
+        method: m.name().to_string(),
+        status,
+        iterations: outcome.iterations,
+        moved_points: disp.moved,
+        moves: outcome.moves,
+        max_displacement: disp.max,
+        max_displacement_index: disp.argmax,
+        sum_displacement: disp.sum,
+        tolerance: options.tolerance,
+        tolerance_met,
+        fix_ends: options.fix_ends,
+        before,
+        after,
+        elapsed_seconds: elapsed.as_secs_f64(),
+        parameters: outcome.parameters,
+        history: outcome.history,
+        notes,
+    };
+    Ok(Faired { points: outcome.points, report, curve: outcome.curve, tangents: outcome.tangents })
+}
+
+/// Scale a proposed set of moves back so that no point ends farther than `tolerance` from its
+/// original position: each point `p` becomes `orig + (p − orig)·min(1, tolerance/|p − orig|)`.
+/// Returns the number of points that were pulled back. Shared by the methods that honour the
+/// tolerance as a hard bound point by point.
+pub fn clamp_to_tolerance(original: &[Point], points: &mut [Point], tolerance: f64) -> usize {
+    let mut clamped = 0;
+    for (p, o) in points.iter_mut().zip(original) {
+        let d = *p - *o;
+        let len = d.length();
+        if len > tolerance {
+            *p = *o + d * (tolerance / len);
+            clamped += 1;
+        }
+    }
+    clamped
+}

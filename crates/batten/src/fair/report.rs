@@ -1,0 +1,87 @@
+use serde::Serialize;
+
+use crate::analysis::FairnessMetrics;
+
+/// How a fairing run ended (after OCCT's `FairCurve_AnalysisCode`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum FairStatus {
+    /// The method's stopping rule was met.
+    #[default]
+    Converged,
+    /// The iteration limit stopped it before its stopping rule was met.
+    IterationLimit,
+    /// Moves were cut short to respect the tolerance; the curve may be less fair than
+    /// the method would make it without the bound.
+    ToleranceLimited,
+    /// The result exceeds the tolerance (the method could not meet it).
+    ToleranceExceeded,
+    /// Nothing needed to change (the input is already fair by the method's criterion).
+    NoChange,
+}
+
+/// One point move of a local method.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Move {
+    /// Iteration number (1-based) of the move.
+    pub iteration: usize,
+    /// Index (0-based) of the point or control point moved.
+    pub index: usize,
+    /// Length of the move.
+    pub distance: f64,
+    /// The method's local badness measure before the move (e.g. third-derivative jump).
+    pub before: f64,
+    /// The same measure after the move.
+    pub after: f64,
+}
+
+/// One row of a per-iteration trace: the method's measure and the largest distance so far.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct HistoryRow {
+    /// Iteration number.
+    pub iteration: usize,
+    /// The method's own fairness measure (energy, GFI, Ê, …) after this iteration.
+    pub measure: f64,
+    /// Largest displacement from the input so far.
+    pub max_distance: f64,
+}
+
+/// What a fairing run did. Serialised as the `--report` JSON.
+#[derive(Clone, Debug, Serialize)]
+pub struct FairReport {
+    /// Method name.
+    pub method: String,
+    /// How it ended.
+    pub status: FairStatus,
+    /// Iterations performed (the method's unit).
+    pub iterations: usize,
+    /// Indices (0-based) of the points whose position changed, increasing.
+    pub moved_points: Vec<usize>,
+    /// The individual moves in order, for local methods.
+    pub moves: Vec<Move>,
+    /// Largest point displacement.
+    pub max_displacement: f64,
+    /// Index of the point with the largest displacement.
+    pub max_displacement_index: usize,
+    /// Sum of point displacements (HAN's S_d).
+    pub sum_displacement: f64,
+    /// The tolerance asked for, if any.
+    pub tolerance: Option<f64>,
+    /// True when no point moved farther than the tolerance (always true without one).
+    pub tolerance_met: bool,
+    /// Whether the end points were fixed.
+    pub fix_ends: bool,
+    /// Metrics of the input.
+    pub before: FairnessMetrics,
+    /// Metrics of the result.
+    pub after: FairnessMetrics,
+    /// Wall-clock time of the method itself, in seconds.
+    pub elapsed_seconds: f64,
+    /// Parameters as used.
+    pub parameters: serde_json::Map<String, serde_json::Value>,
+    /// Per-iteration trace.
+    pub history: Vec<HistoryRow>,
+    /// Remarks for the user.
+    pub notes: Vec<String>,
+}

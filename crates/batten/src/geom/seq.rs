@@ -1,0 +1,147 @@
+use serde::{Deserialize, Serialize};
+
+use super::{BBox, Point};
+use crate::error::{Error, Result};
+
+/// A validated sequence of planar points, open or closed.
+///
+/// Guarantees, checked by [`PointSeq::new`]:
+/// - at least [`PointSeq::MIN_POINTS`] points;
+/// - every coordinate finite;
+/// - no two consecutive points equal (for a closed sequence this includes the last and the
+///   first: a closed curve is given *without* repeating its first point at the end).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PointSeq {
+    points: Vec<Point>,
+    closed: bool,
+}
+
+impl PointSeq {
+    /// The fewest points batten fairs or analyses: a cubic needs four to be determined.
+    pub const MIN_POINTS: usize = 4;
+
+    /// Validate and wrap a point list.
+    ///
+    /// # Errors
+    /// [`Error::TooFewPoints`], [`Error::NonFinite`] or [`Error::DuplicatePoint`] naming the
+    /// index of the first offending point.
+    pub fn new(points: Vec<Point>, closed: bool) -> Result<PointSeq> {
+        validate_points(&points, closed, Self::MIN_POINTS)?;
+        Ok(PointSeq { points, closed })
+    }
+
+    /// An open sequence; see [`PointSeq::new`].
+    ///
+    /// # Errors
+    /// As [`PointSeq::new`].
+    pub fn open(points: Vec<Point>) -> Result<PointSeq> {
+        PointSeq::new(points, false)
+    }
+
+    /// A closed sequence (the last point connects back to the first); see [`PointSeq::new`].
+    ///
+    /// # Errors
+    /// As [`PointSeq::new`].
+    pub fn closed(points: Vec<Point>) -> Result<PointSeq> {
+        PointSeq::new(points, true)
+    }
+
+    /// The points.
+    pub fn points(&self) -> &[Point] {
+        &self.points
+    }
+
+    /// Consume and return the points.
+    pub fn into_points(self) -> Vec<Point> {
+        self.points
+    }
+
+    /// Whether the curve is closed.
+    pub fn is_closed(&self) -> bool {
+        self.closed
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Always false: a `PointSeq` holds at least [`PointSeq::MIN_POINTS`] points.
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// Bounding box of the points.
+    pub fn bbox(&self) -> BBox {
+        // Non-empty by construction.
+        BBox::from_points(&self.points).unwrap_or(BBox { min: Point::ORIGIN, max: Point::ORIGIN })
+    }
+
+    /// The length scale of the data: the diagonal of its bounding box. Tolerances that must
+    /// scale with the data are relative to it.
+    pub fn scale(&self) -> f64 {
+        self.bbox().diagonal()
+    }
+
+    /// A sequence with the same closedness and new points, validated again.
+    ///
+    /// # Errors
+    /// As [`PointSeq::new`].
+    pub fn with_points(&self, points: Vec<Point>) -> Result<PointSeq> {
+        PointSeq::new(points, self.closed)
+    }
+}
+
+/// Check that `points` has at least `min` entries, all finite, with no zero-length chord.
+///
+/// # Errors
+/// [`Error::TooFewPoints`], [`Error::NonFinite`] or [`Error::DuplicatePoint`].
+pub(crate) fn validate_points(points: &[Point], closed: bool, min: usize) -> Result<()> {
+    if points.len() < min {
+        return Err(Error::TooFewPoints { needed: min, got: points.len() });
+    }
+    if let Some(index) = points.iter().position(|p| !p.is_finite()) {
+        return Err(Error::NonFinite { index });
+    }
+    if let Some(i) = points.windows(2).position(|w| w[0] == w[1]) {
+        return Err(Error::DuplicatePoint { index: i + 1 });
+    }
+    if closed && points.first() == points.last() {
+        return Err(Error::DuplicatePoint { index: points.len() - 1 });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> Vec<Point> {
+        vec![
+            Point::new(0.0, 0.0),
+            Point::new(1.0, 0.0),
+            Point::new(1.0, 1.0),
+            Point::new(0.0, 1.0),
+        ]
+    }
+
+    #[test]
+    fn accepts_valid_and_rejects_bad() {
+        assert!(PointSeq::open(square()).is_ok());
+        assert!(PointSeq::closed(square()).is_ok());
+        assert_eq!(
+            PointSeq::open(square()[..3].to_vec()),
+            Err(Error::TooFewPoints { needed: 4, got: 3 })
+        );
+        let mut p = square();
+        p[2].y = f64::NAN;
+        assert_eq!(PointSeq::open(p), Err(Error::NonFinite { index: 2 }));
+        let mut p = square();
+        p[2] = p[1];
+        assert_eq!(PointSeq::open(p), Err(Error::DuplicatePoint { index: 2 }));
+        let mut p = square();
+        p.push(p[0]);
+        assert!(PointSeq::open(p.clone()).is_ok());
+        assert_eq!(PointSeq::closed(p), Err(Error::DuplicatePoint { index: 4 }));
+    }
+}

@@ -1,0 +1,1 @@
+//! Reading and writing point lists and curves (CSV/whitespace text and JSON).

@@ -1,0 +1,31 @@
+//! Numerical building blocks, hand-written for the sizes fairing needs: O(n) banded solves,
+//! Gauss–Legendre quadrature, bracketing 1-D minimisers.
+
+mod band_lu;
+mod banded;
+mod minimize;
+mod quadrature;
+mod tridiagonal;
+
+use std::ops::{Add, Mul, Sub};
+
+pub use band_lu::BandLu;
+pub use banded::SymBanded;
+pub use minimize::{Minimum, minimize_brent, minimize_golden};
+pub use quadrature::GaussLegendre;
+pub use tridiagonal::{solve_cyclic_tridiagonal, solve_tridiagonal};
+
+use crate::geom::Vec2;
+
+/// Values a linear solver can carry on its right-hand side: scalars and plane vectors, so that
+/// one factorisation solves for x and y together.
+pub trait Linear:
+    Copy + Default + Add<Output = Self> + Sub<Output = Self> + Mul<f64, Output = Self>
+{
+}
+
+impl Linear for f64 {}
+impl Linear for Vec2 {}
+
+/// Relative size below which a pivot counts as zero in the banded solvers.
+pub const PIVOT_REL: f64 = 1e-14;

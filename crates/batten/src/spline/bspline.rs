@@ -1,0 +1,359 @@
+use serde::{Deserialize, Serialize};
+
+use super::KnotVector;
+use crate::curve::{Curve, CurveDeriv, Derivatives, Piecewise};
+use crate::error::{Error, Result};
+use crate::geom::{Point, Vec2};
+
+/// A planar B-spline curve of any degree `p ≥ 1`, optionally rational (NURBS).
+///
+/// `x(t) = Σ_i w_i P_i N_{i,p}(t) / Σ_i w_i N_{i,p}(t)` with `m + 1` control points and a knot
+/// vector of `m + p + 2` knots (spec §0.5). The domain is `[u_p, u_{m+1}]`; at its end the
+/// last non-empty span is used.
+///
+/// Serialised as `{"degree": p, "knots": [...], "control_points": [[x, y], ...],
+/// "weights": [...]}` (weights omitted when all are 1).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "BSplineJson", into = "BSplineJson")]
+pub struct BSplineCurve {
+    degree: usize,
+    knots: KnotVector,
+    control_points: Vec<Point>,
+    weights: Option<Vec<f64>>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct BSplineJson {
+    degree: usize,
+    knots: Vec<f64>,
+    control_points: Vec<[f64; 2]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    weights: Option<Vec<f64>>,
+}
+
+impl TryFrom<BSplineJson> for BSplineCurve {
+    type Error = Error;
+    fn try_from(j: BSplineJson) -> Result<BSplineCurve> {
+        let knots = KnotVector::try_new(j.knots)?;
+        let pts = j.control_points.into_iter().map(Point::from).collect();
+        BSplineCurve::try_new(j.degree, knots, pts, j.weights)
+    }
+}
+
+impl From<BSplineCurve> for BSplineJson {
+    fn from(c: BSplineCurve) -> BSplineJson {
+        BSplineJson {
+            degree: c.degree,
+            knots: c.knots.into(),
+            control_points: c.control_points.iter().map(|p| [p.x, p.y]).collect(),
+            weights: c.weights,
+        }
+    }
+}
+
+impl BSplineCurve {
+    /// A B-spline (with `weights = None`) or NURBS curve.
+    ///
+    /// # Errors
+    /// - [`Error::InvalidParameter`] for degree 0;
+    /// - [`Error::TooFewPoints`] for fewer than `degree + 1` control points;
+    /// - [`Error::InvalidKnots`] when the knot count is not `n_ctrl + degree + 1`, a knot has
+    ///   multiplicity above `degree + 1`, or the domain `[u_p, u_{n}]` is empty;
+    /// - [`Error::NonFinite`] for a non-finite control point or weight;
+    /// - [`Error::LengthMismatch`] / [`Error::InvalidParameter`] for weights of the wrong count
+    ///   or not positive.
+    pub fn try_new(
+        degree: usize,
+        knots: KnotVector,
+        control_points: Vec<Point>,
+        weights: Option<Vec<f64>>,
+    ) -> Result<BSplineCurve> {
+        if degree == 0 {
+            return Err(Error::InvalidParameter {
+                name: "degree".into(),
+                reason: "must be at least 1".into(),
+            });
+        }
+        let n = control_points.len();
+        if n < degree + 1 {
+            return Err(Error::TooFewPoints { needed: degree + 1, got: n });
+        }
+        if knots.len() != n + degree + 1 {
+            return Err(Error::InvalidKnots(format!(
+                "{} knots for {n} control points of degree {degree}: expected {}",
+                knots.len(),
+                n + degree + 1
+            )));
+        }
+        let u = knots.as_slice();
+        if u[degree] >= u[n] {
+            return Err(Error::InvalidKnots("the parameter domain is empty".into()));
+        }
+        let mut i = 0;
+        while i < u.len() {
+            let m = u[i..].iter().take_while(|&&k| k == u[i]).count();
+            if m > degree + 1 {
+                return Err(Error::InvalidKnots(format!(
+                    "knot {} has multiplicity {m} > degree + 1",
+                    u[i]
+                )));
+            }
+            i += m;
+        }
+        if let Some(index) = control_points.iter().position(|p| !p.is_finite()) {
+            return Err(Error::NonFinite { index });
+        }
+        if let Some(w) = &weights {
+            if w.len() != n {
+                return Err(Error::LengthMismatch { what: "weights", got: w.len(), expected: n });
+            }
+            if let Some(index) = w.iter().position(|x| !(x.is_finite() && *x > 0.0)) {
+                return Err(Error::InvalidParameter {
+                    name: "weights".into(),
+                    reason: format!("weight {index} must be positive and finite"),
+                });
+            }
+        }
+        Ok(BSplineCurve { degree, knots, control_points, weights })
+    }
+
+    /// As [`BSplineCurve::try_new`].
+    ///
+    /// # Panics
+    /// When [`BSplineCurve::try_new`] would return an error.
+    pub fn new(
+        degree: usize,
+        knots: KnotVector,
+        control_points: Vec<Point>,
+        weights: Option<Vec<f64>>,
+    ) -> BSplineCurve {
+        match BSplineCurve::try_new(degree, knots, control_points, weights) {
+            Ok(c) => c,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    /// The degree p.
+    pub fn degree(&self) -> usize {
+        self.degree
+    }
+
+    /// The knot vector.
+    pub fn knots(&self) -> &KnotVector {
+        &self.knots
+    }
+
+    /// The control points.
+    pub fn control_points(&self) -> &[Point] {
+        &self.control_points
+    }
+
+    /// The weights, `None` for a non-rational curve.
+    pub fn weights(&self) -> Option<&[f64]> {
+        self.weights.as_deref()
+    }
+
+    /// Replace control point `i` (for local fairing moves).
+    ///
+    /// # Panics
+    /// If `i` is out of range.
+    pub fn set_control_point(&mut self, i: usize, p: Point) {
+        self.control_points[i] = p;
+    }
+
+    /// The same curve with new control points (same count), e.g. after a fairing operator.
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] or [`Error::NonFinite`].
+    pub fn with_control_points(&self, pts: Vec<Point>) -> Result<BSplineCurve> {
+        if pts.len() != self.control_points.len() {
+            return Err(Error::LengthMismatch {
+                what: "control points",
+                got: pts.len(),
+                expected: self.control_points.len(),
+            });
+        }
+        BSplineCurve::try_new(self.degree, self.knots.clone(), pts, self.weights.clone())
+    }
+
+    /// The span index k with `u_k ≤ t < u_{k+1}` (see [`KnotVector::find_span`]).
+    pub fn find_span(&self, t: f64) -> usize {
+        self.knots.find_span(self.degree, self.control_points.len(), t)
+    }
+
+    /// The non-zero basis functions `N_{k−p..=k, p}` and their derivatives up to order `nd`
+    /// at `t` in span `k`, written to `out[d][j]` (d = 0..=nd, j = 0..=p). The algorithm of
+    /// Piegl & Tiller (A2.3), with 0/0 := 0 for repeated knots.
+    pub fn basis_derivs(&self, k: usize, t: f64, nd: usize, out: &mut [[f64; MAX_ORDER]; 4]) {
+        basis_derivs(self.knots.as_slice(), self.degree, k, t, nd.min(3), out);
+    }
+
+    /// Position and up to three derivatives, from the span containing `t` (or the one
+    /// ending at `t` when `left` is true and `t` is a knot).
+    fn derivs_in_span(&self, k: usize, t: f64) -> Derivatives {
+        let p = self.degree;
+        let mut b = [[0.0; MAX_ORDER]; 4];
+        basis_derivs(self.knots.as_slice(), p, k, t, 3, &mut b);
+        let cp = &self.control_points[k - p..=k];
+        match &self.weights {
+            None => {
+                let mut d = [Vec2::ZERO; 4];
+                for (j, c) in cp.iter().enumerate() {
+                    let v = c.to_vec2();
+                    for (o, dd) in d.iter_mut().enumerate() {
+                        *dd += v * b[o][j];
+                    }
+                }
+                Derivatives { point: d[0].to_point(), d1: d[1], d2: d[2], d3: d[3] }
+            }
+            Some(w) => {
+                let w = &w[k - p..=k];
+                // Homogeneous derivatives A^(o) = Σ w_j P_j N^(o), W^(o) = Σ w_j N^(o).
+                let mut a = [Vec2::ZERO; 4];
+                let mut ww = [0.0; 4];
+                for (j, c) in cp.iter().enumerate() {
+                    let v = c.to_vec2() * w[j];
+                    for o in 0..4 {
+                        a[o] += v * b[o][j];
+                        ww[o] += w[j] * b[o][j];
+                    }
+                }
+                // Quotient rule (Piegl & Tiller A4.2): C^(o) = (A^(o) − Σ_{i=1}^{o} C(o,i) W^(i) C^(o−i)) / W.
+                let binom = [[1.0, 0.0, 0.0, 0.0], [1.0, 1.0, 0.0, 0.0], [1.0, 2.0, 1.0, 0.0], [1.0, 3.0, 3.0, 1.0]];
+                let mut c = [Vec2::ZERO; 4];
+                for o in 0..4 {
+                    let mut v = a[o];
+                    for i in 1..=o {
+                        v -= c[o - i] * (binom[o][i] * ww[i]);
+                    }
+                    c[o] = v / ww[0];
+                }
+                Derivatives { point: c[0].to_point(), d1: c[1], d2: c[2], d3: c[3] }
+            }
+        }
+    }
+}
+
+/// The largest degree + 1 supported by the fixed-size basis buffers (no allocation per
+/// evaluation): degree ≤ 7.
+pub const MAX_ORDER: usize = 8;
+
+/// Basis functions and derivatives (Piegl & Tiller A2.3) into a fixed buffer.
+pub(crate) fn basis_derivs(
+    u: &[f64],
+    p: usize,
+    k: usize,
+    t: f64,
+    nd: usize,
+    out: &mut [[f64; MAX_ORDER]; 4],
+) {
+    assert!(p < MAX_ORDER, "degree {p} above the supported maximum {}", MAX_ORDER - 1);
+    let mut ndu = [[0.0; MAX_ORDER]; MAX_ORDER];
+    let mut left = [0.0; MAX_ORDER];
+    let mut right = [0.0; MAX_ORDER];
+    ndu[0][0] = 1.0;
+    for j in 1..=p {
+        left[j] = t - u[k + 1 - j];
+        right[j] = u[k + j] - t;
+        let mut saved = 0.0;
+        for r in 0..j {
+            // Lower triangle: knot differences.
+            ndu[j][r] = right[r + 1] + left[j - r];
+            let temp = if ndu[j][r] != 0.0 { ndu[r][j - 1] / ndu[j][r] } else { 0.0 };
+            // Upper triangle: basis functions.
+            ndu[r][j] = saved + right[r + 1] * temp;
+            saved = left[j - r] * temp;
+        }
+        ndu[j][j] = saved;
+    }
+    for row in out.iter_mut() {
+        *row = [0.0; MAX_ORDER];
+    }
+    for j in 0..=p {
+        out[0][j] = ndu[j][p];
+    }
+    let nd = nd.min(p);
+    let mut a = [[0.0; MAX_ORDER]; 2];
+    for r in 0..=p {
+        let (mut s1, mut s2) = (0usize, 1usize);
+        a[0] = [0.0; MAX_ORDER];
+        a[0][0] = 1.0;
+        for kk in 1..=nd {
+            let mut d = 0.0;
+            let rk = r as isize - kk as isize;
+            let pk = p - kk;
+            if r >= kk {
+                let rk = rk as usize;
+                a[s2][0] = if ndu[pk + 1][rk] != 0.0 { a[s1][0] / ndu[pk + 1][rk] } else { 0.0 };
+                d = a[s2][0] * ndu[rk][pk];
+            }
+            let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
+            let j2 = if (r as isize - 1) <= pk as isize { kk - 1 } else { p - r };
+            for j in j1..=j2 {
+                let idx = (rk + j as isize) as usize;
+                a[s2][j] = if ndu[pk + 1][idx] != 0.0 {
+                    (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx]
+                } else {
+                    0.0
+                };
+                d += a[s2][j] * ndu[idx][pk];
+            }
+            if r <= pk {
+                a[s2][kk] = if ndu[pk + 1][r] != 0.0 { -a[s1][kk - 1] / ndu[pk + 1][r] } else { 0.0 };
+                d += a[s2][kk] * ndu[r][pk];
+            }
+            out[kk][r] = d;
+            std::mem::swap(&mut s1, &mut s2);
+        }
+    }
+    let mut f = p as f64;
+    for kk in 1..=nd {
+        for j in 0..=p {
+            out[kk][j] *= f;
+        }
+        f *= (p - kk) as f64;
+    }
+}
+
+impl Curve for BSplineCurve {
+    fn domain(&self) -> (f64, f64) {
+        let u = self.knots.as_slice();
+        (u[self.degree], u[self.control_points.len()])
+    }
+
+    fn eval(&self, t: f64) -> Point {
+        self.derivatives(t).point
+    }
+}
+
+impl CurveDeriv for BSplineCurve {
+    fn derivatives(&self, t: f64) -> Derivatives {
+        self.derivs_in_span(self.find_span(t), t)
+    }
+
+    fn derivatives_left(&self, t: f64) -> Derivatives {
+        let u = self.knots.as_slice();
+        let mut k = self.find_span(t);
+        // At an interior knot, step back to the span that ends at t.
+        while k > self.degree && u[k] == t {
+            k -= 1;
+            if u[k] < u[k + 1] {
+                break;
+            }
+        }
+        self.derivs_in_span(k, t)
+    }
+}
+
+impl Piecewise for BSplineCurve {
+    fn breakpoints(&self) -> Vec<f64> {
+        let (a, b) = self.domain();
+        let mut v: Vec<f64> = Vec::new();
+        for &k in self.knots.as_slice() {
+            if k >= a && k <= b && v.last() != Some(&k) {
+                v.push(k);
+            }
+        }
+        v
+    }
+}

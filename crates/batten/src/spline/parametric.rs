@@ -1,0 +1,412 @@
+//! The C² parametric cubic interpolating spline through planar points (spec §0.2, §2.1).
+
+use serde::{Deserialize, Serialize};
+
+use crate::curve::{Curve, CurveDeriv, Derivatives, Piecewise};
+use crate::error::{Error, Result};
+use crate::geom::{Point, Vec2};
+use crate::numeric::{solve_cyclic_tridiagonal, solve_tridiagonal};
+
+/// How parameter values are assigned to a point sequence (spec §0.2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Parametrization {
+    /// `t_i = i`.
+    Uniform,
+    /// Increments `|P_{i+1} − P_i|`.
+    #[default]
+    ChordLength,
+    /// Increments `|P_{i+1} − P_i|^(1/2)`.
+    Centripetal,
+}
+
+/// End conditions of an open interpolating spline.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EndCondition {
+    /// `r'' = 0` at both ends.
+    Natural,
+    /// Given first derivatives `r'(t_0)`, `r'(t_n)` (with respect to the spline parameter).
+    Clamped(Vec2, Vec2),
+    /// `r'''` continuous at the second and the second-to-last knot (de Boor's not-a-knot).
+    #[default]
+    NotAKnot,
+}
+
+/// Parameter values `t_0 = 0, t_1, …` for a point sequence. For a closed sequence one more
+/// value is returned: the parameter at which the curve returns to `P_0`.
+///
+/// # Errors
+/// [`Error::DuplicatePoint`] for a zero chord, [`Error::NonFinite`] for a non-finite point.
+pub fn parameters(points: &[Point], kind: Parametrization, closed: bool) -> Result<Vec<f64>> {
+    if let Some(index) = points.iter().position(|p| !p.is_finite()) {
+        return Err(Error::NonFinite { index });
+    }
+    let n = points.len();
+    let m = if closed { n } else { n.saturating_sub(1) };
+    let mut t = Vec::with_capacity(m + 1);
+    t.push(0.0);
+    for i in 0..m {
+        let a = points[i];
+        let b = points[(i + 1) % n];
+        let d = (b - a).length();
+        if d == 0.0 {
+            return Err(Error::DuplicatePoint { index: (i + 1) % n });
+        }
+        let inc = match kind {
+            Parametrization::Uniform => 1.0,
+            Parametrization::ChordLength => d,
+            Parametrization::Centripetal => d.sqrt(),
+        };
+        t.push(t[i] + inc);
+    }
+    Ok(t)
+}
+
+/// A piecewise cubic Hermite curve through `P_0..P_m` at parameters `t_0 < … < t_m`; each span
+/// is the cubic with the end positions and first derivatives of its knots (KP eq 6).
+///
+/// Built by [`ParametricCubic::interpolate`] (the C² spline), [`ParametricCubic::closed`]
+/// (the periodic C² spline) or [`ParametricCubic::from_hermite`] (given tangents, C¹). A closed
+/// curve stores `P_0` again as its last knot point, so it has as many spans as points.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParametricCubic {
+    t: Vec<f64>,
+    points: Vec<Point>,
+    tangents: Vec<Vec2>,
+    /// Per span: `a0 + a1 s + a2 s² + a3 s³`, s = t − t_i.
+    coeffs: Vec<[Vec2; 4]>,
+    closed: bool,
+}
+
+impl ParametricCubic {
+    /// The C² interpolating cubic spline through an open point sequence.
+    ///
+    /// # Errors
+    /// [`Error::TooFewPoints`] (fewer than 2 points; not-a-knot needs 4), and the errors of
+    /// [`parameters`].
+    pub fn interpolate(
+        points: &[Point],
+        param: Parametrization,
+        end: EndCondition,
+    ) -> Result<ParametricCubic> {
+        let t = parameters(points, param, false)?;
+        ParametricCubic::interpolate_at(&t, points, end)
+    }
+
+    /// The C² interpolating cubic spline through `points` at the given increasing parameters.
+    ///
+    /// # Errors
+    /// [`Error::TooFewPoints`], [`Error::LengthMismatch`], [`Error::NotIncreasing`],
+    /// [`Error::NonFinite`].
+    pub fn interpolate_at(t: &[f64], points: &[Point], end: EndCondition) -> Result<ParametricCubic> {
+        let n = points.len();
+        let min = if matches!(end, EndCondition::NotAKnot) { 4 } else { 2 };
+        if n < min {
+            return Err(Error::TooFewPoints { needed: min, got: n });
+        }
+        check_params(t, n)?;
+        let dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+        let slope: Vec<Vec2> = (0..n - 1).map(|i| (points[i + 1] - points[i]) / dt[i]).collect();
+        let mut sub = vec![0.0; n];
+        let mut diag = vec![0.0; n];
+        let mut sup = vec![0.0; n];
+        let mut rhs = vec![Vec2::ZERO; n];
+        for i in 1..n - 1 {
+            sub[i] = dt[i];
+            diag[i] = 2.0 * (dt[i - 1] + dt[i]);
+            sup[i] = dt[i - 1];
+            rhs[i] = (slope[i - 1] * dt[i] + slope[i] * dt[i - 1]) * 3.0;
+        }
+        match end {
+            EndCondition::Natural => {
+                diag[0] = 2.0;
+                sup[0] = 1.0;
+                rhs[0] = slope[0] * 3.0;
+                sub[n - 1] = 1.0;
+                diag[n - 1] = 2.0;
+                rhs[n - 1] = slope[n - 2] * 3.0;
+            }
+            EndCondition::Clamped(a, b) => {
+                diag[0] = 1.0;
+                rhs[0] = a;
+                diag[n - 1] = 1.0;
+                rhs[n - 1] = b;
+            }
+            EndCondition::NotAKnot => {
+                let d = t[2] - t[0];
+                diag[0] = dt[1];
+                sup[0] = d;
+                rhs[0] = (slope[0] * ((dt[0] + 2.0 * d) * dt[1]) + slope[1] * (dt[0] * dt[0])) / d;
+                let d = t[n - 1] - t[n - 3];
+                diag[n - 1] = dt[n - 3];
+                sub[n - 1] = d;
+                rhs[n - 1] = (slope[n - 3] * (dt[n - 2] * dt[n - 2])
+                    + slope[n - 2] * ((2.0 * d + dt[n - 2]) * dt[n - 3]))
+                    / d;
+            }
+        }
+        solve_tridiagonal(&sub, &diag, &sup, &mut rhs)?;
+        ParametricCubic::build(t.to_vec(), points.to_vec(), rhs, false)
+    }
+
+    /// The periodic C² cubic spline through a closed point sequence (the last point connects
+    /// back to the first, which must not be repeated).
+    ///
+    /// # Errors
+    /// [`Error::TooFewPoints`] (fewer than 3 points) and the errors of [`parameters`].
+    pub fn closed(points: &[Point], param: Parametrization) -> Result<ParametricCubic> {
+        let n = points.len();
+        if n < 3 {
+            return Err(Error::TooFewPoints { needed: 3, got: n });
+        }
+        let t = parameters(points, param, true)?;
+        let dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect(); // n spans
+        let slope: Vec<Vec2> = (0..n).map(|i| (points[(i + 1) % n] - points[i]) / dt[i]).collect();
+        let mut sub = vec![0.0; n];
+        let mut diag = vec![0.0; n];
+        let mut sup = vec![0.0; n];
+        let mut rhs = vec![Vec2::ZERO; n];
+        for i in 0..n {
+            let im = (i + n - 1) % n;
+            sub[i] = dt[i];
+            diag[i] = 2.0 * (dt[im] + dt[i]);
+            sup[i] = dt[im];
+            rhs[i] = (slope[im] * dt[i] + slope[i] * dt[im]) * 3.0;
+        }
+        solve_cyclic_tridiagonal(&sub, &diag, &sup, &mut rhs)?;
+        let mut pts = points.to_vec();
+        pts.push(points[0]);
+        rhs.push(rhs[0]);
+        ParametricCubic::build(t, pts, rhs, true)
+    }
+
+    /// A C¹ piecewise cubic Hermite curve from parameters, points and tangents (all of equal
+    /// length). For closed Hermite data repeat the first point and tangent at the end.
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`], [`Error::NotIncreasing`], [`Error::NonFinite`],
+    /// [`Error::TooFewPoints`].
+    pub fn from_hermite(t: Vec<f64>, points: Vec<Point>, tangents: Vec<Vec2>) -> Result<ParametricCubic> {
+        if points.len() < 2 {
+            return Err(Error::TooFewPoints { needed: 2, got: points.len() });
+        }
+        check_params(&t, points.len())?;
+        if tangents.len() != points.len() {
+            return Err(Error::LengthMismatch {
+                what: "tangents",
+                got: tangents.len(),
+                expected: points.len(),
+            });
+        }
+        if let Some(index) = tangents.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFinite { index });
+        }
+        ParametricCubic::build(t, points, tangents, false)
+    }
+
+    fn build(t: Vec<f64>, points: Vec<Point>, tangents: Vec<Vec2>, closed: bool) -> Result<ParametricCubic> {
+        let coeffs = (0..points.len() - 1)
+            .map(|i| hermite_coeffs(points[i], points[i + 1], tangents[i], tangents[i + 1], t[i + 1] - t[i]))
+            .collect::<Vec<_>>();
+        if coeffs.iter().flatten().any(|c| !c.is_finite()) {
+            return Err(Error::Singular("spline coefficients are not finite".into()));
+        }
+        Ok(ParametricCubic { t, points, tangents, coeffs, closed })
+    }
+
+    /// The knots (parameter values at the points); a closed curve has one more than points.
+    pub fn knots(&self) -> &[f64] {
+        &self.t
+    }
+
+    /// The interpolated points (a closed curve repeats `P_0` at the end).
+    pub fn points(&self) -> &[Point] {
+        &self.points
+    }
+
+    /// The first derivatives at the knots.
+    pub fn tangents(&self) -> &[Vec2] {
+        &self.tangents
+    }
+
+    /// Whether the curve is periodic.
+    pub fn is_closed(&self) -> bool {
+        self.closed
+    }
+
+    /// Number of cubic spans.
+    pub fn num_spans(&self) -> usize {
+        self.coeffs.len()
+    }
+
+    /// Power-basis coefficients `[a0, a1, a2, a3]` of span `i` in `s = t − t_i` (KP eq 6).
+    pub fn span_coeffs(&self, i: usize) -> [Vec2; 4] {
+        self.coeffs[i]
+    }
+
+    /// The span containing `t` (clamped to the first and last span).
+    pub fn find_span(&self, t: f64) -> usize {
+        let n = self.coeffs.len();
+        match self.t.binary_search_by(|k| k.total_cmp(&t)) {
+            Ok(i) => i.min(n - 1),
+            Err(i) => i.saturating_sub(1).min(n - 1),
+        }
+    }
+
+    /// Jumps `r'''(t_k+) − r'''(t_k−) = 6(a_{k,3} − a_{k−1,3})` at the interior knots
+    /// k = 1..m−1 (KP §2.2). A closed curve has a jump at every knot, `P_0` first.
+    pub fn third_derivative_jumps(&self) -> Vec<Vec2> {
+        let m = self.coeffs.len();
+        if self.closed {
+            (0..m).map(|k| (self.coeffs[k][3] - self.coeffs[(k + m - 1) % m][3]) * 6.0).collect()
+        } else {
+            (1..m).map(|k| (self.coeffs[k][3] - self.coeffs[k - 1][3]) * 6.0).collect()
+        }
+    }
+
+    fn derivs_in_span(&self, i: usize, t: f64) -> Derivatives {
+        let [a0, a1, a2, a3] = self.coeffs[i];
+        let s = t - self.t[i];
+        let p = a0 + (a1 + (a2 + a3 * s) * s) * s;
+        let d1 = a1 + (a2 * 2.0 + a3 * (3.0 * s)) * s;
+        let d2 = a2 * 2.0 + a3 * (6.0 * s);
+        Derivatives { point: p.to_point(), d1, d2, d3: a3 * 6.0 }
+    }
+}
+
+/// KP eq 6: the power-basis coefficients of the cubic Hermite span.
+fn hermite_coeffs(p0: Point, p1: Point, d0: Vec2, d1: Vec2, h: f64) -> [Vec2; 4] {
+    let dp = p1 - p0;
+    let a2 = dp * (3.0 / (h * h)) - (d0 * 2.0 + d1) / h;
+    let a3 = dp * (-2.0 / (h * h * h)) + (d0 + d1) / (h * h);
+    [p0.to_vec2(), d0, a2, a3]
+}
+
+fn check_params(t: &[f64], n: usize) -> Result<()> {
+    if t.len() != n {
+        return Err(Error::LengthMismatch { what: "parameters", got: t.len(), expected: n });
+    }
+    if let Some(index) = t.iter().position(|v| !v.is_finite()) {
+        return Err(Error::NonFinite { index });
+    }
+    if let Some(i) = t.windows(2).position(|w| w[1] <= w[0]) {
+        return Err(Error::NotIncreasing { index: i + 1 });
+    }
+    Ok(())
+}
+
+impl Curve for ParametricCubic {
+    fn domain(&self) -> (f64, f64) {
+        (self.t[0], self.t[self.t.len() - 1])
+    }
+
+    fn eval(&self, t: f64) -> Point {
+        self.derivatives(t).point
+    }
+}
+
+impl CurveDeriv for ParametricCubic {
+    fn derivatives(&self, t: f64) -> Derivatives {
+        self.derivs_in_span(self.find_span(t), t)
+    }
+
+    fn derivatives_left(&self, t: f64) -> Derivatives {
+        let mut i = self.find_span(t);
+        if i > 0 && self.t[i] == t {
+            i -= 1;
+        }
+        self.derivs_in_span(i, t)
+    }
+}
+
+impl Piecewise for ParametricCubic {
+    fn breakpoints(&self) -> Vec<f64> {
+        self.t.clone()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn circle(n: usize, r: f64) -> Vec<Point> {
+        (0..n)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / n as f64;
+                Point::new(r * a.cos(), r * a.sin())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn interpolates_and_is_c2() {
+        let pts: Vec<Point> = (0..9).map(|i| Point::new(i as f64, (i as f64 * 0.7).sin())).collect();
+        for end in [EndCondition::Natural, EndCondition::NotAKnot, EndCondition::Clamped(Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0))] {
+            for par in [Parametrization::Uniform, Parametrization::ChordLength, Parametrization::Centripetal] {
+                let s = ParametricCubic::interpolate(&pts, par, end).unwrap();
+                for (k, p) in s.knots().iter().zip(&pts) {
+                    assert!((s.eval(*k) - *p).length() < 1e-12);
+                }
+                for &k in &s.knots()[1..pts.len() - 1] {
+                    let l = s.derivatives_left(k);
+                    let r = s.derivatives(k);
+                    assert!((l.d1 - r.d1).length() < 1e-10);
+                    assert!((l.d2 - r.d2).length() < 1e-9);
+                }
+                let (a, b) = s.domain();
+                match end {
+                    EndCondition::Natural => {
+                        assert!(s.derivatives(a).d2.length() < 1e-10);
+                        assert!(s.derivatives(b).d2.length() < 1e-10);
+                    }
+                    EndCondition::NotAKnot => {
+                        let j = s.third_derivative_jumps();
+                        assert!(j[0].length() < 1e-9 && j[j.len() - 1].length() < 1e-9);
+                    }
+                    EndCondition::Clamped(d0, d1) => {
+                        assert!((s.derivatives(a).d1 - d0).length() < 1e-12);
+                        assert!((s.derivatives(b).d1 - d1).length() < 1e-12);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn natural_matches_kp_system() {
+        // Not-a-knot reproduces a cubic exactly.
+        let pts: Vec<Point> = (0..7).map(|i| Point::new(i as f64, (i as f64).powi(3) - 2.0 * i as f64)).collect();
+        let t: Vec<f64> = (0..7).map(|i| i as f64).collect();
+        let s = ParametricCubic::interpolate_at(&t, &pts, EndCondition::NotAKnot).unwrap();
+        for k in 0..60 {
+            let x = k as f64 * 0.1;
+            assert!((s.eval(x).y - (x.powi(3) - 2.0 * x)).abs() < 1e-10);
+        }
+    }
+
+    #[test]
+    fn closed_is_periodic_c2() {
+        let pts = circle(12, 2.0);
+        let s = ParametricCubic::closed(&pts, Parametrization::ChordLength).unwrap();
+        let (a, b) = s.domain();
+        let l = s.derivatives_left(b);
+        let r = s.derivatives(a);
+        assert!((l.point - r.point).length() < 1e-12);
+        assert!((l.d1 - r.d1).length() < 1e-10);
+        assert!((l.d2 - r.d2).length() < 1e-9);
+        assert_eq!(s.third_derivative_jumps().len(), 12);
+    }
+
+    #[test]
+    fn rejects_bad_input() {
+        let p = vec![Point::new(0.0, 0.0), Point::new(0.0, 0.0), Point::new(1.0, 0.0), Point::new(2.0, 1.0)];
+        assert_eq!(
+            ParametricCubic::interpolate(&p, Parametrization::ChordLength, EndCondition::Natural),
+            Err(Error::DuplicatePoint { index: 1 })
+        );
+        let t = vec![0.0, 1.0, 1.0, 2.0];
+        let p = vec![Point::new(0.0, 0.0), Point::new(1.0, 0.0), Point::new(2.0, 0.0), Point::new(3.0, 1.0)];
+        assert_eq!(ParametricCubic::interpolate_at(&t, &p, EndCondition::Natural), Err(Error::NotIncreasing { index: 2 }));
+    }
+}
