@@ -33,7 +33,11 @@ impl ArcLengthTable {
             s += gl.integrate(w[0], w[1], |t| curve.derivatives(t).d1.length());
             cumulative.push(s);
         }
-        ArcLengthTable { breaks, cumulative, gl }
+        ArcLengthTable {
+            breaks,
+            cumulative,
+            gl,
+        }
     }
 
     /// Total length.
@@ -58,7 +62,10 @@ impl ArcLengthTable {
             return 0.0;
         }
         let i = self.span_of_t(t);
-        self.cumulative[i] + self.gl.integrate(self.breaks[i], t, |x| curve.derivatives(x).d1.length())
+        self.cumulative[i]
+            + self
+                .gl
+                .integrate(self.breaks[i], t, |x| curve.derivatives(x).d1.length())
     }
 
     /// The parameter at arc length `s` (clamped to `[0, total]`), by Newton's method on
@@ -76,16 +83,29 @@ impl ArcLengthTable {
         let (mut lo, mut hi) = (self.breaks[i], self.breaks[i + 1]);
         let target = s - self.cumulative[i];
         let span_len = self.cumulative[i + 1] - self.cumulative[i];
-        let mut t = lo + (hi - lo) * if span_len > 0.0 { target / span_len } else { 0.5 };
+        let mut t = lo
+            + (hi - lo)
+                * if span_len > 0.0 {
+                    target / span_len
+                } else {
+                    0.5
+                };
         for _ in 0..NEWTON_MAX {
-            let f = self.gl.integrate(self.breaks[i], t, |x| curve.derivatives(x).d1.length()) - target;
+            let f = self
+                .gl
+                .integrate(self.breaks[i], t, |x| curve.derivatives(x).d1.length())
+                - target;
             if f > 0.0 {
                 hi = t;
             } else {
                 lo = t;
             }
             let speed = curve.derivatives(t).d1.length();
-            let mut next = if speed > 0.0 { t - f / speed } else { 0.5 * (lo + hi) };
+            let mut next = if speed > 0.0 {
+                t - f / speed
+            } else {
+                0.5 * (lo + hi)
+            };
             if !(next > lo && next < hi) {
                 next = 0.5 * (lo + hi);
             }

@@ -77,7 +77,10 @@ pub struct CombSample {
 
 /// Curvature-comb samples: `per_span` evenly spaced samples in every span, plus the end of
 /// the domain.
-pub fn curvature_comb<C: CurveDeriv + Piecewise + ?Sized>(curve: &C, per_span: usize) -> Vec<CombSample> {
+pub fn curvature_comb<C: CurveDeriv + Piecewise + ?Sized>(
+    curve: &C,
+    per_span: usize,
+) -> Vec<CombSample> {
     let per_span = per_span.max(1);
     let bp = curve.breakpoints();
     let mut out = Vec::with_capacity(bp.len().saturating_sub(1) * per_span + 1);
@@ -125,14 +128,21 @@ mod tests {
 
     #[test]
     fn curvature_derivative_matches_finite_differences() {
-        let pts: Vec<Point> =
-            (0..10).map(|i| Point::new(i as f64, (i as f64 * 0.5).sin() * 2.0)).collect();
-        let s = ParametricCubic::interpolate(&pts, Parametrization::ChordLength, EndCondition::NotAKnot)
-            .unwrap();
+        let pts: Vec<Point> = (0..10)
+            .map(|i| Point::new(i as f64, (i as f64 * 0.5).sin() * 2.0))
+            .collect();
+        let s = ParametricCubic::interpolate(
+            &pts,
+            Parametrization::ChordLength,
+            EndCondition::NotAKnot,
+        )
+        .unwrap();
         for t in [1.3, 4.2, 7.7] {
             let h = 1e-5;
             let arc = |a: f64, b: f64| {
-                GaussLegendre::default().integrate(a, b, |x| crate::curve::CurveDeriv::derivatives(&s, x).d1.length())
+                GaussLegendre::default().integrate(a, b, |x| {
+                    crate::curve::CurveDeriv::derivatives(&s, x).d1.length()
+                })
             };
             let fd = (curvature_at(&s, t + h) - curvature_at(&s, t - h)) / arc(t - h, t + h);
             let an = curvature_derivative(&crate::curve::CurveDeriv::derivatives(&s, t));

@@ -31,13 +31,24 @@ pub fn fairness_indicators(curve: &BSplineCurve) -> FairnessIndicators {
     let p = curve.degree();
     let u = curve.knots().as_slice();
     let m = curve.control_points().len() - 1;
-    let xi: Vec<f64> = (0..=m).map(|i| u[i + 1..=i + p].iter().sum::<f64>() / p as f64).collect();
+    let xi: Vec<f64> = (0..=m)
+        .map(|i| u[i + 1..=i + p].iter().sum::<f64>() / p as f64)
+        .collect();
     let table = ArcLengthTable::new(curve);
-    let kappa: Vec<f64> = xi.iter().map(|&t| signed_curvature(&curve.derivatives(t))).collect();
+    let kappa: Vec<f64> = xi
+        .iter()
+        .map(|&t| signed_curvature(&curve.derivatives(t)))
+        .collect();
     let s: Vec<f64> = xi.iter().map(|&t| table.s_at(curve, t)).collect();
     let lfi = lfi_from_samples(&kappa, &s, None);
     let gfi = lfi.iter().sum();
-    FairnessIndicators { xi, kappa, s, lfi, gfi }
+    FairnessIndicators {
+        xi,
+        kappa,
+        s,
+        lfi,
+        gfi,
+    }
 }
 
 /// `LFI_i = (κ''_i)²` from curvature samples `kappa` at arc lengths `s` (increasing). With
@@ -62,7 +73,14 @@ pub(crate) fn lfi_from_samples(kappa: &[f64], s: &[f64], period: Option<f64>) ->
         }
         _ => {
             for i in 1..n.saturating_sub(1) {
-                let d = second(kappa[i - 1], kappa[i], kappa[i + 1], s[i - 1], s[i], s[i + 1]);
+                let d = second(
+                    kappa[i - 1],
+                    kappa[i],
+                    kappa[i + 1],
+                    s[i - 1],
+                    s[i],
+                    s[i + 1],
+                );
                 lfi[i] = d * d;
             }
         }

@@ -2,9 +2,9 @@
 
 use serde::Serialize;
 
+use super::ArcLengthTable;
 use super::curvature::{curvature_derivative, signed_curvature, strain_energy, variation_energy};
 use super::gfi::{fairness_indicators, lfi_from_samples};
-use super::ArcLengthTable;
 use crate::curve::CurveDeriv;
 use crate::error::{Error, Result};
 use crate::geom::{Point, PointSeq};
@@ -34,7 +34,11 @@ pub fn sgn0(v: f64, scale: f64) -> i8 {
 /// change from the last non-zero sign back to the first counts too.
 pub fn count_sign_changes(values: &[f64], cyclic: bool) -> usize {
     let scale = values.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-    let signs: Vec<i8> = values.iter().map(|&v| sgn0(v, scale)).filter(|&s| s != 0).collect();
+    let signs: Vec<i8> = values
+        .iter()
+        .map(|&v| sgn0(v, scale))
+        .filter(|&s| s != 0)
+        .collect();
     let mut n = signs.windows(2).filter(|w| w[0] != w[1]).count();
     if cyclic && signs.len() > 1 && signs[0] != signs[signs.len() - 1] {
         n += 1;
@@ -88,7 +92,11 @@ pub fn analysis_curve(seq: &PointSeq) -> Result<ParametricCubic> {
     if seq.is_closed() {
         ParametricCubic::closed(seq.points(), Parametrization::ChordLength)
     } else {
-        ParametricCubic::interpolate(seq.points(), Parametrization::ChordLength, EndCondition::NotAKnot)
+        ParametricCubic::interpolate(
+            seq.points(),
+            Parametrization::ChordLength,
+            EndCondition::NotAKnot,
+        )
     }
 }
 
@@ -124,7 +132,11 @@ impl FairnessMetrics {
             // Extrema and max |κ|: dense samples, both one-sided limits at the knots.
             for j in 0..=SAMPLES_PER_SPAN {
                 let tt = t[i] + h * j as f64 / SAMPLES_PER_SPAN as f64;
-                let d = if j == SAMPLES_PER_SPAN { curve.derivatives_left(tt) } else { curve.derivatives(tt) };
+                let d = if j == SAMPLES_PER_SPAN {
+                    curve.derivatives_left(tt)
+                } else {
+                    curve.derivatives(tt)
+                };
                 max_curvature = max_curvature.max(signed_curvature(&d).abs());
                 dk_seq.push(curvature_derivative(&d));
             }
@@ -136,24 +148,39 @@ impl FairnessMetrics {
         let curvature_extrema = count_sign_changes(&dk_seq, closed);
 
         // Vibrations: jumps of dκ/ds at the knots where r''' jumps.
-        let knots: Vec<usize> = if closed { (0..m).collect() } else { (1..m).collect() };
+        let knots: Vec<usize> = if closed {
+            (0..m).collect()
+        } else {
+            (1..m).collect()
+        };
         let jumps: Vec<f64> = knots
             .iter()
             .map(|&k| {
                 let right = curve.derivatives(t[k]);
-                let left = if k == 0 { curve.derivatives_left(t[m]) } else { curve.derivatives_left(t[k]) };
+                let left = if k == 0 {
+                    curve.derivatives_left(t[m])
+                } else {
+                    curve.derivatives_left(t[k])
+                };
                 curvature_derivative(&right) - curvature_derivative(&left)
             })
             .collect();
         let vibrations = count_sign_changes(&jumps, closed);
-        let max_third_derivative_jump =
-            curve.third_derivative_jumps().iter().fold(0.0_f64, |a, j| a.max(j.length()));
+        let max_third_derivative_jump = curve
+            .third_derivative_jumps()
+            .iter()
+            .fold(0.0_f64, |a, j| a.max(j.length()));
 
         let gfi = if closed {
             let table = ArcLengthTable::new(&curve);
-            let kappa: Vec<f64> = t[..m].iter().map(|&x| signed_curvature(&curve.derivatives(x))).collect();
+            let kappa: Vec<f64> = t[..m]
+                .iter()
+                .map(|&x| signed_curvature(&curve.derivatives(x)))
+                .collect();
             let s: Vec<f64> = t[..m].iter().map(|&x| table.s_at(&curve, x)).collect();
-            lfi_from_samples(&kappa, &s, Some(table.total())).iter().sum()
+            lfi_from_samples(&kappa, &s, Some(table.total()))
+                .iter()
+                .sum()
         } else {
             let (bs, _) = BSplineCurve::interpolate(seq.points(), 3, Parametrization::ChordLength)?;
             fairness_indicators(&bs).gfi
@@ -194,9 +221,18 @@ pub struct Displacement {
 /// [`Error::LengthMismatch`] when the lengths differ.
 pub fn displacement(a: &[Point], b: &[Point]) -> Result<Displacement> {
     if a.len() != b.len() {
-        return Err(Error::LengthMismatch { what: "point sets", got: b.len(), expected: a.len() });
+        return Err(Error::LengthMismatch {
+            what: "point sets",
+            got: b.len(),
+            expected: a.len(),
+        });
     }
-    let mut d = Displacement { max: 0.0, argmax: 0, sum: 0.0, moved: Vec::new() };
+    let mut d = Displacement {
+        max: 0.0,
+        argmax: 0,
+        sum: 0.0,
+        moved: Vec::new(),
+    };
     for (i, (p, q)) in a.iter().zip(b).enumerate() {
         let dist = p.distance(*q);
         d.sum += dist;

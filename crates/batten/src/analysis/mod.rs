@@ -16,6 +16,5 @@ pub use curvature::{
 };
 pub use gfi::{FairnessIndicators, fairness_indicators};
 pub use metrics::{
-    Displacement, FairnessMetrics, ZERO_REL, analysis_curve, count_sign_changes, displacement,
-    sgn0,
+    Displacement, FairnessMetrics, ZERO_REL, analysis_curve, count_sign_changes, displacement, sgn0,
 };

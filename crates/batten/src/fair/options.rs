@@ -124,10 +124,13 @@ impl FairOptions {
     pub fn param_usize_in(&self, key: &str, default: usize, lo: usize, hi: usize) -> Result<usize> {
         let v = match self.params.get(key) {
             None => default,
-            Some(s) => s.trim().parse::<usize>().map_err(|_| Error::InvalidParameter {
-                name: key.into(),
-                reason: format!("'{s}' is not a whole number"),
-            })?,
+            Some(s) => s
+                .trim()
+                .parse::<usize>()
+                .map_err(|_| Error::InvalidParameter {
+                    name: key.into(),
+                    reason: format!("'{s}' is not a whole number"),
+                })?,
         };
         if !(lo..=hi).contains(&v) {
             return Err(Error::InvalidParameter {
@@ -142,15 +145,22 @@ impl FairOptions {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming the allowed values.
-    pub fn param_choice(&self, key: &str, default: &'static str, choices: &[&'static str]) -> Result<&'static str> {
+    pub fn param_choice(
+        &self,
+        key: &str,
+        default: &'static str,
+        choices: &[&'static str],
+    ) -> Result<&'static str> {
         match self.params.get(key) {
             None => Ok(default),
-            Some(s) => choices.iter().copied().find(|c| *c == s.trim()).ok_or_else(|| {
-                Error::InvalidParameter {
+            Some(s) => choices
+                .iter()
+                .copied()
+                .find(|c| *c == s.trim())
+                .ok_or_else(|| Error::InvalidParameter {
                     name: key.into(),
                     reason: format!("'{s}' is not one of {}", choices.join(", ")),
-                }
-            }),
+                }),
         }
     }
 }

@@ -33,7 +33,10 @@ impl Point {
     /// The vector from the origin to this point.
     #[inline]
     pub const fn to_vec2(self) -> Vec2 {
-        Vec2 { x: self.x, y: self.y }
+        Vec2 {
+            x: self.x,
+            y: self.y,
+        }
     }
 
     /// Euclidean distance to another point.
@@ -74,7 +77,10 @@ impl Vec2 {
     /// The point at this offset from the origin.
     #[inline]
     pub const fn to_point(self) -> Point {
-        Point { x: self.x, y: self.y }
+        Point {
+            x: self.x,
+            y: self.y,
+        }
     }
 
     /// Dot product.
@@ -117,7 +123,10 @@ impl Vec2 {
     /// This vector rotated by +90° (counter-clockwise).
     #[inline]
     pub fn perp(self) -> Vec2 {
-        Vec2 { x: -self.y, y: self.x }
+        Vec2 {
+            x: -self.y,
+            y: self.x,
+        }
     }
 
     /// The vector scaled to unit length, or `None` when its length is zero or not finite.
@@ -280,7 +289,10 @@ impl BBox {
     /// The smallest box containing every point, or `None` for an empty slice.
     pub fn from_points(points: &[Point]) -> Option<BBox> {
         let first = *points.first()?;
-        let mut b = BBox { min: first, max: first };
+        let mut b = BBox {
+            min: first,
+            max: first,
+        };
         for p in &points[1..] {
             b.min.x = b.min.x.min(p.x);
             b.min.y = b.min.y.min(p.y);
@@ -313,7 +325,10 @@ impl BBox {
     /// The box grown by `margin` on every side.
     pub fn inflate(&self, margin: f64) -> BBox {
         let m = Vec2::new(margin, margin);
-        BBox { min: self.min - m, max: self.max + m }
+        BBox {
+            min: self.min - m,
+            max: self.max + m,
+        }
     }
 }
 

@@ -74,7 +74,10 @@ impl PointSeq {
     /// Bounding box of the points.
     pub fn bbox(&self) -> BBox {
         // Non-empty by construction.
-        BBox::from_points(&self.points).unwrap_or(BBox { min: Point::ORIGIN, max: Point::ORIGIN })
+        BBox::from_points(&self.points).unwrap_or(BBox {
+            min: Point::ORIGIN,
+            max: Point::ORIGIN,
+        })
     }
 
     /// The length scale of the data: the diagonal of its bounding box. Tolerances that must
@@ -98,7 +101,10 @@ impl PointSeq {
 /// [`Error::TooFewPoints`], [`Error::NonFinite`] or [`Error::DuplicatePoint`].
 pub(crate) fn validate_points(points: &[Point], closed: bool, min: usize) -> Result<()> {
     if points.len() < min {
-        return Err(Error::TooFewPoints { needed: min, got: points.len() });
+        return Err(Error::TooFewPoints {
+            needed: min,
+            got: points.len(),
+        });
     }
     if let Some(index) = points.iter().position(|p| !p.is_finite()) {
         return Err(Error::NonFinite { index });
@@ -107,7 +113,9 @@ pub(crate) fn validate_points(points: &[Point], closed: bool, min: usize) -> Res
         return Err(Error::DuplicatePoint { index: i + 1 });
     }
     if closed && points.first() == points.last() {
-        return Err(Error::DuplicatePoint { index: points.len() - 1 });
+        return Err(Error::DuplicatePoint {
+            index: points.len() - 1,
+        });
     }
     Ok(())
 }

@@ -13,12 +13,20 @@ pub struct Rigid {
 
 impl Rigid {
     /// The identity motion.
-    pub const IDENTITY: Rigid = Rigid { cos: 1.0, sin: 0.0, translation: Vec2::ZERO };
+    pub const IDENTITY: Rigid = Rigid {
+        cos: 1.0,
+        sin: 0.0,
+        translation: Vec2::ZERO,
+    };
 
     /// Rotation by `angle` radians (counter-clockwise) about the origin, then translation.
     pub fn new(angle: f64, translation: Vec2) -> Rigid {
         let (sin, cos) = angle.sin_cos();
-        Rigid { cos, sin, translation }
+        Rigid {
+            cos,
+            sin,
+            translation,
+        }
     }
 
     /// Pure rotation about the origin.
@@ -28,7 +36,10 @@ impl Rigid {
 
     /// Pure translation.
     pub fn translation(v: Vec2) -> Rigid {
-        Rigid { translation: v, ..Rigid::IDENTITY }
+        Rigid {
+            translation: v,
+            ..Rigid::IDENTITY
+        }
     }
 
     /// The motion that maps `origin` to (0, 0) and the direction `x_axis` (an angle in radians)
@@ -36,7 +47,10 @@ impl Rigid {
     pub fn to_local_frame(origin: Point, x_axis: f64) -> Rigid {
         let rot = Rigid::rotation(-x_axis);
         let t = rot.apply_vec(-origin.to_vec2());
-        Rigid { translation: t, ..rot }
+        Rigid {
+            translation: t,
+            ..rot
+        }
     }
 
     /// The rotation angle in radians.
@@ -56,14 +70,24 @@ impl Rigid {
     /// Apply to a vector (rotation only: vectors do not translate).
     #[inline]
     pub fn apply_vec(&self, v: Vec2) -> Vec2 {
-        Vec2::new(self.cos * v.x - self.sin * v.y, self.sin * v.x + self.cos * v.y)
+        Vec2::new(
+            self.cos * v.x - self.sin * v.y,
+            self.sin * v.x + self.cos * v.y,
+        )
     }
 
     /// The inverse motion.
     pub fn inverse(&self) -> Rigid {
-        let r = Rigid { cos: self.cos, sin: -self.sin, translation: Vec2::ZERO };
+        let r = Rigid {
+            cos: self.cos,
+            sin: -self.sin,
+            translation: Vec2::ZERO,
+        };
         let t = -r.apply_vec(self.translation);
-        Rigid { translation: t, ..r }
+        Rigid {
+            translation: t,
+            ..r
+        }
     }
 
     /// `self` after `first`: the motion `p ↦ self(first(p))`.
@@ -71,7 +95,11 @@ impl Rigid {
         let cos = self.cos * first.cos - self.sin * first.sin;
         let sin = self.sin * first.cos + self.cos * first.sin;
         let translation = self.apply_vec(first.translation) + self.translation;
-        Rigid { cos, sin, translation }
+        Rigid {
+            cos,
+            sin,
+            translation,
+        }
     }
 }
 

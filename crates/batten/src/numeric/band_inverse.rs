@@ -62,7 +62,11 @@ mod tests {
             let mut dense = nalgebra::DMatrix::<f64>::zeros(n, n);
             for i in 0..n {
                 for k in 0..=bw.min(i) {
-                    let v = if k == 0 { 5.0 + (i as f64).sin() } else { 0.4 - 0.1 * (i + k) as f64 / n as f64 };
+                    let v = if k == 0 {
+                        5.0 + (i as f64).sin()
+                    } else {
+                        0.4 - 0.1 * (i + k) as f64 / n as f64
+                    };
                     a.add(i, i - k, v);
                     dense[(i, i - k)] = v;
                     dense[(i - k, i)] = v;
@@ -73,7 +77,10 @@ mod tests {
             let inv = dense.try_inverse().unwrap();
             for i in 0..n {
                 for j in i.saturating_sub(bw)..=i {
-                    assert!((s.get(i, j) - inv[(i, j)]).abs() < 1e-13, "bw {bw} ({i},{j})");
+                    assert!(
+                        (s.get(i, j) - inv[(i, j)]).abs() < 1e-13,
+                        "bw {bw} ({i},{j})"
+                    );
                 }
             }
         }

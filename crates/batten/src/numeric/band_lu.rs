@@ -19,7 +19,13 @@ pub struct BandLu {
 impl BandLu {
     /// A zero n×n band matrix.
     pub fn zeros(n: usize, kl: usize, ku: usize) -> BandLu {
-        BandLu { n, kl, ku, data: vec![0.0; n * (kl + ku + 1)], factored: false }
+        BandLu {
+            n,
+            kl,
+            ku,
+            data: vec![0.0; n * (kl + ku + 1)],
+            factored: false,
+        }
     }
 
     fn idx(&self, i: usize, j: usize) -> Option<usize> {
@@ -51,7 +57,11 @@ impl BandLu {
     /// [`Error::Singular`] for a (relatively) zero pivot.
     pub fn factorize(&mut self) -> Result<()> {
         let n = self.n;
-        let scale = self.data.iter().fold(0.0_f64, |m, v| m.max(v.abs())).max(f64::MIN_POSITIVE);
+        let scale = self
+            .data
+            .iter()
+            .fold(0.0_f64, |m, v| m.max(v.abs()))
+            .max(f64::MIN_POSITIVE);
         for k in 0..n {
             let Some(pk) = self.idx(k, k) else { continue };
             let piv = self.data[pk];
@@ -66,7 +76,9 @@ impl BandLu {
                     continue;
                 }
                 for j in k + 1..(k + self.ku + 1).min(n) {
-                    let (Some(ij), Some(kj)) = (self.idx(i, j), self.idx(k, j)) else { continue };
+                    let (Some(ij), Some(kj)) = (self.idx(i, j), self.idx(k, j)) else {
+                        continue;
+                    };
                     self.data[ij] -= f * self.data[kj];
                 }
             }
@@ -87,7 +99,11 @@ impl BandLu {
             });
         }
         if rhs.len() != self.n {
-            return Err(Error::LengthMismatch { what: "rhs", got: rhs.len(), expected: self.n });
+            return Err(Error::LengthMismatch {
+                what: "rhs",
+                got: rhs.len(),
+                expected: self.n,
+            });
         }
         let n = self.n;
         for i in 0..n {
@@ -119,13 +135,19 @@ mod tests {
         let mut dense = vec![vec![0.0; n]; n];
         for i in 0..n {
             for j in i.saturating_sub(2)..(i + 2).min(n) {
-                let v = if i == j { 5.0 + i as f64 } else { 1.0 / (1.0 + (i + 2 * j) as f64) };
+                let v = if i == j {
+                    5.0 + i as f64
+                } else {
+                    1.0 / (1.0 + (i + 2 * j) as f64)
+                };
                 a.set(i, j, v);
                 dense[i][j] = v;
             }
         }
         let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
-        let mut b: Vec<f64> = (0..n).map(|i| (0..n).map(|j| dense[i][j] * x[j]).sum()).collect();
+        let mut b: Vec<f64> = (0..n)
+            .map(|i| (0..n).map(|j| dense[i][j] * x[j]).sum())
+            .collect();
         a.factorize().unwrap();
         a.solve_in_place(&mut b).unwrap();
         for i in 0..n {

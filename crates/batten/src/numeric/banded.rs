@@ -17,7 +17,12 @@ pub struct SymBanded {
 impl SymBanded {
     /// A zero n×n matrix with half-bandwidth `bw`.
     pub fn zeros(n: usize, bw: usize) -> SymBanded {
-        SymBanded { n, bw, band: vec![0.0; n * (bw + 1)], factored: false }
+        SymBanded {
+            n,
+            bw,
+            band: vec![0.0; n * (bw + 1)],
+            factored: false,
+        }
     }
 
     /// Dimension.
@@ -33,7 +38,11 @@ impl SymBanded {
     /// `A[i][j]` for `|i − j| ≤ bw` (either triangle); zero outside the band.
     pub fn get(&self, i: usize, j: usize) -> f64 {
         let (i, j) = if i >= j { (i, j) } else { (j, i) };
-        if i - j > self.bw { 0.0 } else { self.band[i * (self.bw + 1) + (i - j)] }
+        if i - j > self.bw {
+            0.0
+        } else {
+            self.band[i * (self.bw + 1) + (i - j)]
+        }
     }
 
     /// Add `v` to `A[i][j]` (and so to `A[j][i]`).
@@ -113,7 +122,11 @@ impl SymBanded {
             });
         }
         if rhs.len() != self.n {
-            return Err(Error::LengthMismatch { what: "rhs", got: rhs.len(), expected: self.n });
+            return Err(Error::LengthMismatch {
+                what: "rhs",
+                got: rhs.len(),
+                expected: self.n,
+            });
         }
         let (n, w) = (self.n, self.bw + 1);
         for i in 0..n {
@@ -166,7 +179,9 @@ mod tests {
             }
         }
         let x: Vec<f64> = (0..n).map(|i| (i as f64).sqrt() - 1.0).collect();
-        let mut b: Vec<f64> = (0..n).map(|i| (0..n).map(|j| dense[i][j] * x[j]).sum()).collect();
+        let mut b: Vec<f64> = (0..n)
+            .map(|i| (0..n).map(|j| dense[i][j] * x[j]).sum())
+            .collect();
         a.factorize().unwrap();
         a.solve_in_place(&mut b).unwrap();
         for i in 0..n {

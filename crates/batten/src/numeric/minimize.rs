@@ -17,7 +17,11 @@ const GOLDEN: f64 = 0.381_966_011_250_105_1; // (3 − √5)/2
 pub fn minimize_golden(mut f: impl FnMut(f64) -> f64, a: f64, b: f64, tol: f64) -> Minimum {
     let (mut lo, mut hi) = if a <= b { (a, b) } else { (b, a) };
     let tol = tol.max(f64::EPSILON * (lo.abs() + hi.abs()));
-    let mut best = Minimum { x: lo, fx: f(lo), evaluations: 1 };
+    let mut best = Minimum {
+        x: lo,
+        fx: f(lo),
+        evaluations: 1,
+    };
     let consider = |x: f64, fx: f64, best: &mut Minimum| {
         if fx < best.fx || best.fx.is_nan() {
             best.x = x;
@@ -105,7 +109,13 @@ pub fn minimize_brent(
             e = if x < m { b - x } else { a - x };
             d = GOLDEN * e;
         }
-        let u = if d.abs() >= tol { x + d } else if d > 0.0 { x + tol } else { x - tol };
+        let u = if d.abs() >= tol {
+            x + d
+        } else if d > 0.0 {
+            x + tol
+        } else {
+            x - tol
+        };
         let fu = f(u);
         evaluations += 1;
         if fu <= fx {

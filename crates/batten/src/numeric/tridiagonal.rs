@@ -21,7 +21,10 @@ pub fn solve_tridiagonal<T: Linear>(
     if n == 0 {
         return Ok(());
     }
-    let scale = diag.iter().fold(0.0_f64, |m, d| m.max(d.abs())).max(f64::MIN_POSITIVE);
+    let scale = diag
+        .iter()
+        .fold(0.0_f64, |m, d| m.max(d.abs()))
+        .max(f64::MIN_POSITIVE);
     let mut c = vec![0.0; n];
     let mut beta = diag[0];
     if beta.abs() <= PIVOT_REL * scale {
@@ -87,7 +90,15 @@ pub fn solve_cyclic_tridiagonal<T: Linear>(
 }
 
 fn check_len(what: &'static str, got: usize, expected: usize) -> Result<()> {
-    if got == expected { Ok(()) } else { Err(Error::LengthMismatch { what, got, expected }) }
+    if got == expected {
+        Ok(())
+    } else {
+        Err(Error::LengthMismatch {
+            what,
+            got,
+            expected,
+        })
+    }
 }
 
 #[cfg(test)]

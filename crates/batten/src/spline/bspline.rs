@@ -76,7 +76,10 @@ impl BSplineCurve {
         }
         let n = control_points.len();
         if n < degree + 1 {
-            return Err(Error::TooFewPoints { needed: degree + 1, got: n });
+            return Err(Error::TooFewPoints {
+                needed: degree + 1,
+                got: n,
+            });
         }
         if knots.len() != n + degree + 1 {
             return Err(Error::InvalidKnots(format!(
@@ -105,7 +108,11 @@ impl BSplineCurve {
         }
         if let Some(w) = &weights {
             if w.len() != n {
-                return Err(Error::LengthMismatch { what: "weights", got: w.len(), expected: n });
+                return Err(Error::LengthMismatch {
+                    what: "weights",
+                    got: w.len(),
+                    expected: n,
+                });
             }
             if let Some(index) = w.iter().position(|x| !(x.is_finite() && *x > 0.0)) {
                 return Err(Error::InvalidParameter {
@@ -114,7 +121,12 @@ impl BSplineCurve {
                 });
             }
         }
-        Ok(BSplineCurve { degree, knots, control_points, weights })
+        Ok(BSplineCurve {
+            degree,
+            knots,
+            control_points,
+            weights,
+        })
     }
 
     /// As [`BSplineCurve::try_new`].
@@ -178,7 +190,8 @@ impl BSplineCurve {
 
     /// The span index k with `u_k ≤ t < u_{k+1}` (see [`KnotVector::find_span`]).
     pub fn find_span(&self, t: f64) -> usize {
-        self.knots.find_span(self.degree, self.control_points.len(), t)
+        self.knots
+            .find_span(self.degree, self.control_points.len(), t)
     }
 
     /// The non-zero basis functions `N_{k−p..=k, p}` and their derivatives up to order `nd`
@@ -204,7 +217,12 @@ impl BSplineCurve {
                         *dd += v * b[o][j];
                     }
                 }
-                Derivatives { point: d[0].to_point(), d1: d[1], d2: d[2], d3: d[3] }
+                Derivatives {
+                    point: d[0].to_point(),
+                    d1: d[1],
+                    d2: d[2],
+                    d3: d[3],
+                }
             }
             Some(w) => {
                 let w = &w[k - p..=k];
@@ -219,7 +237,12 @@ impl BSplineCurve {
                     }
                 }
                 // Quotient rule (Piegl & Tiller A4.2): C^(o) = (A^(o) − Σ_{i=1}^{o} C(o,i) W^(i) C^(o−i)) / W.
-                let binom = [[1.0, 0.0, 0.0, 0.0], [1.0, 1.0, 0.0, 0.0], [1.0, 2.0, 1.0, 0.0], [1.0, 3.0, 3.0, 1.0]];
+                let binom = [
+                    [1.0, 0.0, 0.0, 0.0],
+                    [1.0, 1.0, 0.0, 0.0],
+                    [1.0, 2.0, 1.0, 0.0],
+                    [1.0, 3.0, 3.0, 1.0],
+                ];
                 let mut c = [Vec2::ZERO; 4];
                 for o in 0..4 {
                     let mut v = a[o];
@@ -228,7 +251,12 @@ impl BSplineCurve {
                     }
                     c[o] = v / ww[0];
                 }
-                Derivatives { point: c[0].to_point(), d1: c[1], d2: c[2], d3: c[3] }
+                Derivatives {
+                    point: c[0].to_point(),
+                    d1: c[1],
+                    d2: c[2],
+                    d3: c[3],
+                }
             }
         }
     }
@@ -247,7 +275,11 @@ pub(crate) fn basis_derivs(
     nd: usize,
     out: &mut [[f64; MAX_ORDER]; 4],
 ) {
-    assert!(p < MAX_ORDER, "degree {p} above the supported maximum {}", MAX_ORDER - 1);
+    assert!(
+        p < MAX_ORDER,
+        "degree {p} above the supported maximum {}",
+        MAX_ORDER - 1
+    );
     let mut ndu = [[0.0; MAX_ORDER]; MAX_ORDER];
     let mut left = [0.0; MAX_ORDER];
     let mut right = [0.0; MAX_ORDER];
@@ -259,7 +291,11 @@ pub(crate) fn basis_derivs(
         for r in 0..j {
             // Lower triangle: knot differences.
             ndu[j][r] = right[r + 1] + left[j - r];
-            let temp = if ndu[j][r] != 0.0 { ndu[r][j - 1] / ndu[j][r] } else { 0.0 };
+            let temp = if ndu[j][r] != 0.0 {
+                ndu[r][j - 1] / ndu[j][r]
+            } else {
+                0.0
+            };
             // Upper triangle: basis functions.
             ndu[r][j] = saved + right[r + 1] * temp;
             saved = left[j - r] * temp;
@@ -284,11 +320,19 @@ pub(crate) fn basis_derivs(
             let pk = p - kk;
             if r >= kk {
                 let rk = rk as usize;
-                a[s2][0] = if ndu[pk + 1][rk] != 0.0 { a[s1][0] / ndu[pk + 1][rk] } else { 0.0 };
+                a[s2][0] = if ndu[pk + 1][rk] != 0.0 {
+                    a[s1][0] / ndu[pk + 1][rk]
+                } else {
+                    0.0
+                };
                 d = a[s2][0] * ndu[rk][pk];
             }
             let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
-            let j2 = if (r as isize - 1) <= pk as isize { kk - 1 } else { p - r };
+            let j2 = if (r as isize - 1) <= pk as isize {
+                kk - 1
+            } else {
+                p - r
+            };
             for j in j1..=j2 {
                 let idx = (rk + j as isize) as usize;
                 a[s2][j] = if ndu[pk + 1][idx] != 0.0 {
@@ -299,7 +343,11 @@ pub(crate) fn basis_derivs(
                 d += a[s2][j] * ndu[idx][pk];
             }
             if r <= pk {
-                a[s2][kk] = if ndu[pk + 1][r] != 0.0 { -a[s1][kk - 1] / ndu[pk + 1][r] } else { 0.0 };
+                a[s2][kk] = if ndu[pk + 1][r] != 0.0 {
+                    -a[s1][kk - 1] / ndu[pk + 1][r]
+                } else {
+                    0.0
+                };
                 d += a[s2][kk] * ndu[r][pk];
             }
             out[kk][r] = d;

@@ -29,7 +29,10 @@ impl BSplineCurve {
         }
         let n = points.len();
         if n < p + 1 {
-            return Err(Error::TooFewPoints { needed: p + 1, got: n });
+            return Err(Error::TooFewPoints {
+                needed: p + 1,
+                got: n,
+            });
         }
         let mut t = parameters(points, param, false)?;
         let total = t[n - 1];
@@ -55,7 +58,9 @@ impl BSplineCurve {
                 if col.abs_diff(row) <= p {
                     a.set(row, col, b[0][j]);
                 } else if b[0][j] != 0.0 {
-                    return Err(Error::Singular("collocation matrix outside its band".into()));
+                    return Err(Error::Singular(
+                        "collocation matrix outside its band".into(),
+                    ));
                 }
             }
         }
@@ -75,8 +80,9 @@ mod tests {
 
     #[test]
     fn interpolates_through_points() {
-        let pts: Vec<Point> =
-            (0..12).map(|i| Point::new(i as f64 * 0.5, (i as f64 * 0.4).sin())).collect();
+        let pts: Vec<Point> = (0..12)
+            .map(|i| Point::new(i as f64 * 0.5, (i as f64 * 0.4).sin()))
+            .collect();
         for p in 1..=5 {
             let (c, t) = BSplineCurve::interpolate(&pts, p, Parametrization::ChordLength).unwrap();
             for (tk, q) in t.iter().zip(&pts) {

@@ -52,7 +52,10 @@ impl KnotVector {
     /// [`Error::TooFewPoints`] when `n_ctrl < p + 1`.
     pub fn clamped_uniform(p: usize, n_ctrl: usize) -> Result<KnotVector> {
         if n_ctrl < p + 1 {
-            return Err(Error::TooFewPoints { needed: p + 1, got: n_ctrl });
+            return Err(Error::TooFewPoints {
+                needed: p + 1,
+                got: n_ctrl,
+            });
         }
         let spans = n_ctrl - p;
         let mut k = vec![0.0; p + 1];
@@ -154,7 +157,10 @@ mod tests {
     #[test]
     fn clamped_uniform_and_spans() {
         let k = KnotVector::clamped_uniform(3, 8).unwrap();
-        assert_eq!(k.as_slice(), &[0.0, 0.0, 0.0, 0.0, 0.2, 0.4, 0.6, 0.8, 1.0, 1.0, 1.0, 1.0]);
+        assert_eq!(
+            k.as_slice(),
+            &[0.0, 0.0, 0.0, 0.0, 0.2, 0.4, 0.6, 0.8, 1.0, 1.0, 1.0, 1.0]
+        );
         assert_eq!(k.find_span(3, 8, 0.0), 3);
         assert_eq!(k.find_span(3, 8, 0.2), 4);
         assert_eq!(k.find_span(3, 8, 0.99), 7);

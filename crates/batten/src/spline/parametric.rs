@@ -99,15 +99,28 @@ impl ParametricCubic {
     /// # Errors
     /// [`Error::TooFewPoints`], [`Error::LengthMismatch`], [`Error::NotIncreasing`],
     /// [`Error::NonFinite`].
-    pub fn interpolate_at(t: &[f64], points: &[Point], end: EndCondition) -> Result<ParametricCubic> {
+    pub fn interpolate_at(
+        t: &[f64],
+        points: &[Point],
+        end: EndCondition,
+    ) -> Result<ParametricCubic> {
         let n = points.len();
-        let min = if matches!(end, EndCondition::NotAKnot) { 4 } else { 2 };
+        let min = if matches!(end, EndCondition::NotAKnot) {
+            4
+        } else {
+            2
+        };
         if n < min {
-            return Err(Error::TooFewPoints { needed: min, got: n });
+            return Err(Error::TooFewPoints {
+                needed: min,
+                got: n,
+            });
         }
         check_params(t, n)?;
         let dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-        let slope: Vec<Vec2> = (0..n - 1).map(|i| (points[i + 1] - points[i]) / dt[i]).collect();
+        let slope: Vec<Vec2> = (0..n - 1)
+            .map(|i| (points[i + 1] - points[i]) / dt[i])
+            .collect();
         let mut sub = vec![0.0; n];
         let mut diag = vec![0.0; n];
         let mut sup = vec![0.0; n];
@@ -162,7 +175,9 @@ impl ParametricCubic {
         }
         let t = parameters(points, param, true)?;
         let dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect(); // n spans
-        let slope: Vec<Vec2> = (0..n).map(|i| (points[(i + 1) % n] - points[i]) / dt[i]).collect();
+        let slope: Vec<Vec2> = (0..n)
+            .map(|i| (points[(i + 1) % n] - points[i]) / dt[i])
+            .collect();
         let mut sub = vec![0.0; n];
         let mut diag = vec![0.0; n];
         let mut sup = vec![0.0; n];
@@ -187,9 +202,16 @@ impl ParametricCubic {
     /// # Errors
     /// [`Error::LengthMismatch`], [`Error::NotIncreasing`], [`Error::NonFinite`],
     /// [`Error::TooFewPoints`].
-    pub fn from_hermite(t: Vec<f64>, points: Vec<Point>, tangents: Vec<Vec2>) -> Result<ParametricCubic> {
+    pub fn from_hermite(
+        t: Vec<f64>,
+        points: Vec<Point>,
+        tangents: Vec<Vec2>,
+    ) -> Result<ParametricCubic> {
         if points.len() < 2 {
-            return Err(Error::TooFewPoints { needed: 2, got: points.len() });
+            return Err(Error::TooFewPoints {
+                needed: 2,
+                got: points.len(),
+            });
         }
         check_params(&t, points.len())?;
         if tangents.len() != points.len() {
@@ -205,14 +227,33 @@ impl ParametricCubic {
         ParametricCubic::build(t, points, tangents, false)
     }
 
-    fn build(t: Vec<f64>, points: Vec<Point>, tangents: Vec<Vec2>, closed: bool) -> Result<ParametricCubic> {
+    fn build(
+        t: Vec<f64>,
+        points: Vec<Point>,
+        tangents: Vec<Vec2>,
+        closed: bool,
+    ) -> Result<ParametricCubic> {
         let coeffs = (0..points.len() - 1)
-            .map(|i| hermite_coeffs(points[i], points[i + 1], tangents[i], tangents[i + 1], t[i + 1] - t[i]))
+            .map(|i| {
+                hermite_coeffs(
+                    points[i],
+                    points[i + 1],
+                    tangents[i],
+                    tangents[i + 1],
+                    t[i + 1] - t[i],
+                )
+            })
             .collect::<Vec<_>>();
         if coeffs.iter().flatten().any(|c| !c.is_finite()) {
             return Err(Error::Singular("spline coefficients are not finite".into()));
         }
-        Ok(ParametricCubic { t, points, tangents, coeffs, closed })
+        Ok(ParametricCubic {
+            t,
+            points,
+            tangents,
+            coeffs,
+            closed,
+        })
     }
 
     /// The knots (parameter values at the points); a closed curve has one more than points.
@@ -259,9 +300,13 @@ impl ParametricCubic {
     pub fn third_derivative_jumps(&self) -> Vec<Vec2> {
         let m = self.coeffs.len();
         if self.closed {
-            (0..m).map(|k| (self.coeffs[k][3] - self.coeffs[(k + m - 1) % m][3]) * 6.0).collect()
+            (0..m)
+                .map(|k| (self.coeffs[k][3] - self.coeffs[(k + m - 1) % m][3]) * 6.0)
+                .collect()
         } else {
-            (1..m).map(|k| (self.coeffs[k][3] - self.coeffs[k - 1][3]) * 6.0).collect()
+            (1..m)
+                .map(|k| (self.coeffs[k][3] - self.coeffs[k - 1][3]) * 6.0)
+                .collect()
         }
     }
 
@@ -271,7 +316,12 @@ impl ParametricCubic {
         let p = a0 + (a1 + (a2 + a3 * s) * s) * s;
         let d1 = a1 + (a2 * 2.0 + a3 * (3.0 * s)) * s;
         let d2 = a2 * 2.0 + a3 * (6.0 * s);
-        Derivatives { point: p.to_point(), d1, d2, d3: a3 * 6.0 }
+        Derivatives {
+            point: p.to_point(),
+            d1,
+            d2,
+            d3: a3 * 6.0,
+        }
     }
 }
 
@@ -285,7 +335,11 @@ fn hermite_coeffs(p0: Point, p1: Point, d0: Vec2, d1: Vec2, h: f64) -> [Vec2; 4]
 
 fn check_params(t: &[f64], n: usize) -> Result<()> {
     if t.len() != n {
-        return Err(Error::LengthMismatch { what: "parameters", got: t.len(), expected: n });
+        return Err(Error::LengthMismatch {
+            what: "parameters",
+            got: t.len(),
+            expected: n,
+        });
     }
     if let Some(index) = t.iter().position(|v| !v.is_finite()) {
         return Err(Error::NonFinite { index });
@@ -341,9 +395,19 @@ mod tests {
 
     #[test]
     fn interpolates_and_is_c2() {
-        let pts: Vec<Point> = (0..9).map(|i| Point::new(i as f64, (i as f64 * 0.7).sin())).collect();
-        for end in [EndCondition::Natural, EndCondition::NotAKnot, EndCondition::Clamped(Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0))] {
-            for par in [Parametrization::Uniform, Parametrization::ChordLength, Parametrization::Centripetal] {
+        let pts: Vec<Point> = (0..9)
+            .map(|i| Point::new(i as f64, (i as f64 * 0.7).sin()))
+            .collect();
+        for end in [
+            EndCondition::Natural,
+            EndCondition::NotAKnot,
+            EndCondition::Clamped(Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0)),
+        ] {
+            for par in [
+                Parametrization::Uniform,
+                Parametrization::ChordLength,
+                Parametrization::Centripetal,
+            ] {
                 let s = ParametricCubic::interpolate(&pts, par, end).unwrap();
                 for (k, p) in s.knots().iter().zip(&pts) {
                     assert!((s.eval(*k) - *p).length() < 1e-12);
@@ -376,7 +440,9 @@ mod tests {
     #[test]
     fn natural_matches_kp_system() {
         // Not-a-knot reproduces a cubic exactly.
-        let pts: Vec<Point> = (0..7).map(|i| Point::new(i as f64, (i as f64).powi(3) - 2.0 * i as f64)).collect();
+        let pts: Vec<Point> = (0..7)
+            .map(|i| Point::new(i as f64, (i as f64).powi(3) - 2.0 * i as f64))
+            .collect();
         let t: Vec<f64> = (0..7).map(|i| i as f64).collect();
         let s = ParametricCubic::interpolate_at(&t, &pts, EndCondition::NotAKnot).unwrap();
         for k in 0..60 {
@@ -400,13 +466,26 @@ mod tests {
 
     #[test]
     fn rejects_bad_input() {
-        let p = vec![Point::new(0.0, 0.0), Point::new(0.0, 0.0), Point::new(1.0, 0.0), Point::new(2.0, 1.0)];
+        let p = vec![
+            Point::new(0.0, 0.0),
+            Point::new(0.0, 0.0),
+            Point::new(1.0, 0.0),
+            Point::new(2.0, 1.0),
+        ];
         assert_eq!(
             ParametricCubic::interpolate(&p, Parametrization::ChordLength, EndCondition::Natural),
             Err(Error::DuplicatePoint { index: 1 })
         );
         let t = vec![0.0, 1.0, 1.0, 2.0];
-        let p = vec![Point::new(0.0, 0.0), Point::new(1.0, 0.0), Point::new(2.0, 0.0), Point::new(3.0, 1.0)];
-        assert_eq!(ParametricCubic::interpolate_at(&t, &p, EndCondition::Natural), Err(Error::NotIncreasing { index: 2 }));
+        let p = vec![
+            Point::new(0.0, 0.0),
+            Point::new(1.0, 0.0),
+            Point::new(2.0, 0.0),
+            Point::new(3.0, 1.0),
+        ];
+        assert_eq!(
+            ParametricCubic::interpolate_at(&t, &p, EndCondition::Natural),
+            Err(Error::NotIncreasing { index: 2 })
+        );
     }
 }
