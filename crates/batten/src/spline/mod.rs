@@ -1,15 +1,19 @@
 //! Spline representations and their constructors.
 //!
 //! - [`ParametricCubic`]: the C² cubic interpolating spline through planar points;
+//! - [`CubicSplineFn`]: the cubic spline *function* y(x) of HAN (spec §1.2), end conditions
+//!   [`FnEndCondition`];
 //! - [`KnotVector`] and [`BSplineCurve`]: B-spline / NURBS curves of any degree.
 //!
 //! Nothing here knows about fairing.
 
 mod bspline;
+mod function;
 mod interpolate;
 mod knots;
 mod parametric;
 
 pub use bspline::{BSplineCurve, MAX_ORDER};
+pub use function::{CubicSplineFn, FnEndCondition};
 pub use knots::KnotVector;
 pub use parametric::{EndCondition, ParametricCubic, Parametrization, parameters};
