@@ -1,1 +1,674 @@
 //! Reading and writing point lists and curves (CSV/whitespace text and JSON).
+//!
+//! The format follows the file name's extension ([`Format::from_path`]): `.csv` and `.txt`
+//! are text (one `x,y` per line, see [Text format](#text-format)), `.json` is JSON.
+//!
+//! - [`read_points`] reads a point list and validates it into a [`PointSeq`], keeping the
+//!   1-based line of every point so that every error names the file and the line:
+//!   `data.csv:9: point duplicates the previous one (line 8)`.
+//! - [`read_curve_json`] reads a B-spline curve; [`read_points`] refuses one.
+//! - [`write_points`] writes atomically (a temporary file beside the target, renamed over it)
+//!   and numbers in their shortest exact form: what is written reads back bit for bit.
+//! - [`ensure_distinct`] refuses an output path that is the input file.
+//!
+//! Nothing here prints; every failure is an [`IoError`].
+//!
+//! # Text format
+//!
+//! One point per line as `x,y`, `x;y` or `x y` (spaces or tabs); `#` starts a comment (whole
+//! line or trailing); blank lines are skipped; a first line with no number in it (`x,y`) is a
+//! header. Written files start with the header `x,y`. See `io/text.rs` for the exact rules.
+//!
+//! # JSON format
+//!
+//! `{"points": [[x, y], ...], "closed": false, "tangents": [[dx, dy], ...]}`, `closed` and
+//! `tangents` optional; a B-spline as [`BSplineCurve`] serialises. Other keys are errors.
+//!
+//! ```
+//! use batten::io::{read_points, write_points, ReadOptions};
+//! # fn main() -> Result<(), batten::io::IoError> {
+//! let dir = std::env::temp_dir().join(format!("batten-io-doc-{}", std::process::id()));
+//! std::fs::create_dir_all(&dir).map_err(|source| batten::io::IoError::Write {
+//!     path: dir.clone(),
+//!     source,
+//! })?;
+//! let path = dir.join("arc.csv");
+//! let pts: Vec<batten::Point> = (0..5)
+//!     .map(|i| batten::Point::new(i as f64, (i * i) as f64 * 0.1))
+//!     .collect();
+//! write_points(&path, &pts, false, None)?;
+//! let back = read_points(&path, &ReadOptions::default())?;
+//! assert_eq!(back.seq.points(), &pts[..]);
+//! assert_eq!(back.lines, vec![2, 3, 4, 5, 6]); // line 1 is the header
+//! # std::fs::remove_dir_all(&dir).ok();
+//! # Ok(())
+//! # }
+//! ```
+
+mod error;
+mod json;
+mod text;
+
+use std::fs;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+pub use error::IoError;
+pub use text::format_f64;
+
+use crate::error::Error;
+use crate::geom::{Point, PointSeq, Vec2};
+use crate::spline::BSplineCurve;
+
+/// A file format, chosen by extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Format {
+    /// `.csv` or `.txt`: one `x,y` per line.
+    Text,
+    /// `.json`: a point list object or a B-spline object.
+    Json,
+}
+
+impl Format {
+    /// The format named by the extension of `path` (case-insensitive): `csv`/`txt` → text,
+    /// `json` → JSON.
+    ///
+    /// # Errors
+    /// [`IoError::UnknownFormat`] for any other extension or none.
+    pub fn from_path(path: &Path) -> Result<Format, IoError> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("csv" | "txt") => Ok(Format::Text),
+            Some("json") => Ok(Format::Json),
+            _ => Err(IoError::UnknownFormat {
+                path: path.to_path_buf(),
+            }),
+        }
+    }
+}
+
+/// How to read a point list.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct ReadOptions {
+    /// Treat the points as a closed curve even if the file does not say so (a JSON file
+    /// says so with `"closed": true`; a text file cannot).
+    ///
+    /// Default value: `false`.
+    pub closed: bool,
+}
+
+impl ReadOptions {
+    /// The defaults: closedness as the file says.
+    pub const DEFAULT: ReadOptions = ReadOptions { closed: false };
+
+    /// Force (or not) a closed curve.
+    pub fn with_closed(mut self, closed: bool) -> ReadOptions {
+        self.closed = closed;
+        self
+    }
+}
+
+impl Default for ReadOptions {
+    fn default() -> ReadOptions {
+        ReadOptions::DEFAULT
+    }
+}
+
+/// A point list read from a file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointData {
+    /// The validated points, closed if the file or the options say so.
+    pub seq: PointSeq,
+    /// Tangents given with the points (JSON `tangents`), one per point.
+    pub tangents: Option<Vec<Vec2>>,
+    /// The 1-based line each point starts on, to name it in later messages.
+    pub lines: Vec<usize>,
+}
+
+/// Read a point list (format by extension) and validate it.
+///
+/// # Errors
+/// [`IoError::Read`], [`IoError::UnknownFormat`], and everything [`parse_points`] reports.
+pub fn read_points(path: &Path, options: &ReadOptions) -> Result<PointData, IoError> {
+    let format = Format::from_path(path)?;
+    let bytes = read_bytes(path)?;
+    parse_points(&bytes, format, path, options)
+}
+
+/// Parse and validate a point list held in memory; `path` names it in messages.
+///
+/// # Errors
+/// One error naming the line, for the first problem met: [`IoError::NotUtf8`],
+/// [`IoError::FieldCount`], [`IoError::NotANumber`], [`IoError::NonFinite`], [`IoError::Json`],
+/// [`IoError::CurveNotPoints`]; then, for the whole list, [`IoError::Empty`],
+/// [`IoError::TooFewPoints`], [`IoError::DuplicatePoint`], [`IoError::RepeatsFirst`],
+/// [`IoError::TangentCount`].
+pub fn parse_points(
+    bytes: &[u8],
+    format: Format,
+    path: &Path,
+    options: &ReadOptions,
+) -> Result<PointData, IoError> {
+    let (points, lines, closed, tangents, tangent_lines) = match format {
+        Format::Text => {
+            let t = text::parse(bytes, path)?;
+            (t.points, t.lines, false, None, Vec::new())
+        }
+        Format::Json => {
+            let j = json::parse_points(bytes, path)?;
+            (j.points, j.lines, j.closed, j.tangents, j.tangent_lines)
+        }
+    };
+    let closed = closed || options.closed;
+    let seq = validate(path, points, &lines, closed)?;
+    if let Some(t) = &tangents {
+        if t.len() != seq.len() {
+            return Err(IoError::TangentCount {
+                path: path.to_path_buf(),
+                got: t.len(),
+                expected: seq.len(),
+            });
+        }
+        if let Some(i) = t.iter().position(|v| !v.is_finite()) {
+            return Err(IoError::NonFinite {
+                path: path.to_path_buf(),
+                line: tangent_lines.get(i).copied().unwrap_or(1),
+            });
+        }
+    }
+    Ok(PointData {
+        seq,
+        tangents,
+        lines,
+    })
+}
+
+/// Wrap the points in a [`PointSeq`], turning its index-based errors into line-based ones.
+fn validate(
+    path: &Path,
+    points: Vec<Point>,
+    lines: &[usize],
+    closed: bool,
+) -> Result<PointSeq, IoError> {
+    if points.is_empty() {
+        return Err(IoError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    let line = |i: usize| lines.get(i).copied().unwrap_or(1);
+    match PointSeq::new(points.clone(), closed) {
+        Ok(seq) => Ok(seq),
+        Err(Error::TooFewPoints { needed, got }) => Err(IoError::TooFewPoints {
+            path: path.to_path_buf(),
+            got,
+            needed,
+        }),
+        Err(Error::NonFinite { index }) => Err(IoError::NonFinite {
+            path: path.to_path_buf(),
+            line: line(index),
+        }),
+        Err(Error::DuplicatePoint { index })
+            if index > 0 && points.get(index - 1) == points.get(index) =>
+        {
+            Err(IoError::DuplicatePoint {
+                path: path.to_path_buf(),
+                line: line(index),
+                previous: line(index - 1),
+            })
+        }
+        Err(Error::DuplicatePoint { index }) => Err(IoError::RepeatsFirst {
+            path: path.to_path_buf(),
+            line: line(index),
+            first: line(0),
+        }),
+        Err(source) => Err(IoError::Invalid {
+            path: path.to_path_buf(),
+            source,
+        }),
+    }
+}
+
+/// Read a B-spline curve from a JSON file.
+///
+/// # Errors
+/// [`IoError::Read`], [`IoError::UnknownFormat`] (not `.json`), [`IoError::Json`] (malformed,
+/// or a curve the library rejects, e.g. a knot vector of the wrong length),
+/// [`IoError::PointsNotCurve`].
+pub fn read_curve_json(path: &Path) -> Result<BSplineCurve, IoError> {
+    if Format::from_path(path)? != Format::Json {
+        return Err(IoError::UnknownFormat {
+            path: path.to_path_buf(),
+        });
+    }
+    let bytes = read_bytes(path)?;
+    json::parse_curve(&bytes, path)
+}
+
+fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
+    fs::read(path).map_err(|source| IoError::Read {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Write a point list (format by extension), atomically (see [`write_atomic`]).
+///
+/// Text files get the header `x,y` and one row per point; `closed` and `tangents` are
+/// written to JSON only (a text file has no place for them). Numbers are written in the
+/// shortest form that reads back bit for bit ([`format_f64`] for text; serde_json's, which
+/// is the same digits, for JSON).
+///
+/// # Errors
+/// [`IoError::UnknownFormat`], [`IoError::NonFiniteOutput`], [`IoError::Write`].
+pub fn write_points(
+    path: &Path,
+    points: &[Point],
+    closed: bool,
+    tangents: Option<&[Vec2]>,
+) -> Result<(), IoError> {
+    let format = Format::from_path(path)?;
+    let bad_point = points.iter().position(|p| !p.is_finite());
+    let bad_tangent = tangents.and_then(|t| t.iter().position(|v| !v.is_finite()));
+    if let Some(index) = bad_point.or(bad_tangent) {
+        return Err(IoError::NonFiniteOutput {
+            path: path.to_path_buf(),
+            index,
+        });
+    }
+    let contents = match format {
+        Format::Text => text::format(points),
+        Format::Json => json::format(points, closed, tangents),
+    };
+    write_atomic(path, contents.as_bytes())
+}
+
+/// Distinguishes temporary files of concurrent writes from one process.
+static TEMP_COUNTER: AtomicUsize = AtomicUsize::new(0);
+
+/// How many temporary names to try before giving up.
+const TEMP_ATTEMPTS: usize = 64;
+
+/// Write `contents` to `path` atomically: into a new temporary file in the same directory
+/// (`.NAME.PID.N.tmp`), flushed to disk, then renamed over `path`. Readers see the old file
+/// or the new one, never a partial one; on failure the temporary file is removed and `path`
+/// is untouched. The new file has default permissions; a symbolic link at `path` is
+/// replaced by the file, not followed.
+///
+/// # Errors
+/// [`IoError::Write`].
+pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), IoError> {
+    let write_err = |source| IoError::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    let name = path.file_name().ok_or_else(|| {
+        write_err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a file name",
+        ))
+    })?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut attempt = 0;
+    let (tmp, mut file) = loop {
+        let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
+        let mut tmp_name = std::ffi::OsString::from(".");
+        tmp_name.push(name);
+        tmp_name.push(format!(".{}.{n}.tmp", std::process::id()));
+        let tmp = dir.join(tmp_name);
+        match fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&tmp)
+        {
+            Ok(f) => break (tmp, f),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && attempt < TEMP_ATTEMPTS => {
+                attempt += 1;
+            }
+            Err(e) => return Err(write_err(e)),
+        }
+    };
+    let result = file
+        .write_all(contents)
+        .and_then(|()| file.sync_all())
+        .and_then(|()| {
+            drop(file);
+            fs::rename(&tmp, path)
+        });
+    result.map_err(|e| {
+        // Best effort: the temporary file may already be gone.
+        let _ = fs::remove_file(&tmp);
+        write_err(e)
+    })
+}
+
+/// Refuse to write `output` when it is the file `input` (the same file after resolving `.`,
+/// `..` and symbolic links, or, on Unix, another hard link to it).
+///
+/// Paths that cannot be resolved (an input that does not exist, an output in a missing
+/// directory) are not the same file; writing will report its own error.
+///
+/// # Errors
+/// [`IoError::SameFile`].
+pub fn ensure_distinct(input: &Path, output: &Path) -> Result<(), IoError> {
+    let same = IoError::SameFile {
+        input: input.to_path_buf(),
+        output: output.to_path_buf(),
+    };
+    let Ok(input_real) = fs::canonicalize(input) else {
+        return Ok(());
+    };
+    match resolve(output) {
+        Some(out) if out == input_real => return Err(same),
+        _ => {}
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt as _;
+        if let (Ok(a), Ok(b)) = (fs::metadata(input), fs::metadata(output))
+            && a.dev() == b.dev()
+            && a.ino() == b.ino()
+        {
+            return Err(same);
+        }
+    }
+    Ok(())
+}
+
+/// The canonical path `path` names or would name once created.
+fn resolve(path: &Path) -> Option<PathBuf> {
+    if let Ok(p) = fs::canonicalize(path) {
+        return Some(p);
+    }
+    let name = path.file_name()?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    Some(fs::canonicalize(dir).ok()?.join(name))
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str, options: &ReadOptions) -> Result<PointData, IoError> {
+        parse_points(
+            text.as_bytes(),
+            Format::Text,
+            Path::new("data.csv"),
+            options,
+        )
+    }
+
+    fn msg(text: &str) -> String {
+        match parse(text, &ReadOptions::default()) {
+            Ok(_) => panic!("expected an error for {text:?}"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    fn tempdir() -> PathBuf {
+        let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
+        let d = std::env::temp_dir().join(format!("batten-io-test-{}-{n}", std::process::id()));
+        fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    const SQUARE: &str = "x,y\n0,0\n1,0\n1,1\n0,1\n";
+
+    #[test]
+    fn format_from_extension() {
+        assert_eq!(Format::from_path(Path::new("a.csv")).unwrap(), Format::Text);
+        assert_eq!(Format::from_path(Path::new("a.TXT")).unwrap(), Format::Text);
+        assert_eq!(
+            Format::from_path(Path::new("d/a.Json")).unwrap(),
+            Format::Json
+        );
+        for bad in ["a.dat", "a", "a.csv.gz", ".csv"] {
+            let e = Format::from_path(Path::new(bad)).unwrap_err().to_string();
+            assert_eq!(
+                e,
+                format!("{bad}: unknown file format (use a .csv, .txt or .json file name)")
+            );
+        }
+    }
+
+    #[test]
+    fn validation_errors_name_lines() {
+        assert_eq!(msg(""), "data.csv: no points");
+        assert_eq!(msg("# nothing\nx,y\n\n"), "data.csv: no points");
+        assert_eq!(
+            msg("x,y\n0,0\n1,1\n2,0\n"),
+            "data.csv: 3 points, at least 4 needed"
+        );
+        assert_eq!(
+            msg("x,y\n0,0\n1,1\n2,0\n3,1\n4,0\n# c\n\n4,0\n"),
+            "data.csv:9: point duplicates the previous one (line 6)"
+        );
+        assert_eq!(
+            msg("0,0\n1,1\n2,0\n3,1\n4,0\n5,1\n6,0\n7,1\n8,1\n8,1\n"),
+            "data.csv:10: point duplicates the previous one (line 9)"
+        );
+        // A repeated first point is fine for an open curve, not for a closed one.
+        let ring = "x,y\n0,0\n1,0\n1,1\n0,1\n0,0\n";
+        assert!(parse(ring, &ReadOptions::default()).is_ok());
+        let e = parse(ring, &ReadOptions::default().with_closed(true))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "data.csv:6: closed curve repeats its first point (line 2); leave the repeated point out"
+        );
+    }
+
+    #[test]
+    fn closed_from_options_or_json() {
+        let d = parse(SQUARE, &ReadOptions::default()).unwrap();
+        assert!(!d.seq.is_closed());
+        assert_eq!(d.lines, vec![2, 3, 4, 5]);
+        let d = parse(SQUARE, &ReadOptions::default().with_closed(true)).unwrap();
+        assert!(d.seq.is_closed());
+        let j = br#"{"points": [[0,0],[1,0],[1,1],[0,1]], "closed": true}"#;
+        let d = parse_points(j, Format::Json, Path::new("c.json"), &ReadOptions::DEFAULT).unwrap();
+        assert!(d.seq.is_closed());
+    }
+
+    #[test]
+    fn json_validation_errors_name_lines() {
+        let j = "{\"points\": [\n[0, 0],\n[1, 0],\n[1, 0],\n[2, 1]\n]}";
+        let e = parse_points(
+            j.as_bytes(),
+            Format::Json,
+            Path::new("d.json"),
+            &ReadOptions::DEFAULT,
+        )
+        .unwrap_err()
+        .to_string();
+        assert_eq!(e, "d.json:4: point duplicates the previous one (line 3)");
+        let j = "{\"points\": [[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]],\n \"closed\": true}";
+        let e = parse_points(
+            j.as_bytes(),
+            Format::Json,
+            Path::new("d.json"),
+            &ReadOptions::DEFAULT,
+        )
+        .unwrap_err()
+        .to_string();
+        assert_eq!(
+            e,
+            "d.json:1: closed curve repeats its first point (line 1); leave the repeated point out"
+        );
+        let j = "{\"points\": [[0, 0], [1, 0], [1, 1], [0, 1]],\n \"tangents\": [[1, 0]]}";
+        let e = parse_points(
+            j.as_bytes(),
+            Format::Json,
+            Path::new("d.json"),
+            &ReadOptions::DEFAULT,
+        )
+        .unwrap_err()
+        .to_string();
+        assert_eq!(e, "d.json: 1 tangents for 4 points");
+        let e = parse_points(
+            b"{\"points\": []}",
+            Format::Json,
+            Path::new("d.json"),
+            &ReadOptions::DEFAULT,
+        )
+        .unwrap_err()
+        .to_string();
+        assert_eq!(e, "d.json: no points");
+    }
+
+    #[test]
+    fn write_read_round_trip_both_formats() {
+        let dir = tempdir();
+        let pts = vec![
+            Point::new(-0.0, 1e-300),
+            Point::new(1e300, 5e-324),
+            Point::new(0.1, -1.0 / 3.0),
+            Point::new(f64::MIN_POSITIVE / 3.0, f64::MAX),
+            Point::new(std::f64::consts::PI, -1e-7),
+        ];
+        let tangents = vec![Vec2::new(0.6, 0.8); 5];
+        for name in ["p.csv", "p.txt", "p.json"] {
+            let path = dir.join(name);
+            write_points(&path, &pts, false, Some(&tangents)).unwrap();
+            let back = read_points(&path, &ReadOptions::DEFAULT).unwrap();
+            assert_eq!(back.seq.len(), pts.len());
+            for (a, b) in pts.iter().zip(back.seq.points()) {
+                assert_eq!(a.x.to_bits(), b.x.to_bits(), "{name}");
+                assert_eq!(a.y.to_bits(), b.y.to_bits(), "{name}");
+            }
+            let want_tangents = name.ends_with(".json").then(|| tangents.clone());
+            assert_eq!(back.tangents, want_tangents);
+        }
+        let text = fs::read_to_string(dir.join("p.csv")).unwrap();
+        assert!(text.starts_with("x,y\n-0,1e-300\n1e300,5e-324\n"), "{text}");
+        let path = dir.join("closed.json");
+        write_points(&path, &pts, true, None).unwrap();
+        assert!(
+            read_points(&path, &ReadOptions::DEFAULT)
+                .unwrap()
+                .seq
+                .is_closed()
+        );
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn write_rejects_non_finite_and_unknown_format() {
+        let dir = tempdir();
+        let mut pts = vec![Point::new(0.0, 0.0); 4];
+        pts[2].y = f64::NAN;
+        let path = dir.join("o.csv");
+        let e = write_points(&path, &pts, false, None)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            format!(
+                "{}: cannot write point 2: NaN or infinite value",
+                path.display()
+            )
+        );
+        assert!(!path.exists());
+        let path = dir.join("o.xyz");
+        assert!(matches!(
+            write_points(&path, &[], false, None),
+            Err(IoError::UnknownFormat { .. })
+        ));
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn atomic_write_replaces_and_leaves_no_temporaries() {
+        let dir = tempdir();
+        let path = dir.join("a.csv");
+        fs::write(&path, "old").unwrap();
+        write_atomic(&path, b"new").unwrap();
+        assert_eq!(fs::read_to_string(&path).unwrap(), "new");
+        let names: Vec<_> = fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("a.csv")]);
+        // Into a missing directory: an error naming the target, nothing created.
+        let missing = dir.join("no/such/dir/a.csv");
+        let e = write_atomic(&missing, b"x").unwrap_err().to_string();
+        assert!(
+            e.starts_with(&format!("{}: cannot write: ", missing.display())),
+            "{e}"
+        );
+        // Over a directory: the rename fails and the temporary file is removed.
+        fs::create_dir(dir.join("sub.csv")).unwrap();
+        assert!(write_atomic(&dir.join("sub.csv"), b"x").is_err());
+        let mut names: Vec<_> = fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        names.sort();
+        assert_eq!(
+            names,
+            vec![std::ffi::OsString::from("a.csv"), "sub.csv".into()]
+        );
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn ensure_distinct_sees_through_paths_and_links() {
+        let dir = tempdir();
+        let input = dir.join("in.csv");
+        fs::write(&input, SQUARE).unwrap();
+        fs::create_dir(dir.join("sub")).unwrap();
+        assert!(ensure_distinct(&input, &dir.join("out.csv")).is_ok());
+        assert!(ensure_distinct(&input, &dir.join("no/such/out.csv")).is_ok());
+        let e = ensure_distinct(&input, &dir.join("sub/../in.csv")).unwrap_err();
+        assert!(matches!(e, IoError::SameFile { .. }));
+        assert!(e.to_string().starts_with("refusing to write "), "{e}");
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(&input, dir.join("link.csv")).unwrap();
+            assert!(ensure_distinct(&input, &dir.join("link.csv")).is_err());
+            fs::hard_link(&input, dir.join("hard.csv")).unwrap();
+            assert!(ensure_distinct(&input, &dir.join("hard.csv")).is_err());
+        }
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn read_errors_name_the_file() {
+        let e = read_points(Path::new("/no/such/file.csv"), &ReadOptions::DEFAULT)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("/no/such/file.csv: cannot read: "), "{e}");
+        let dir = tempdir();
+        let p = dir.join("curve.json");
+        fs::write(
+            &p,
+            r#"{"degree": 2, "knots": [0, 0, 0, 1, 1, 1], "control_points": [[0, 0], [1, 2], [2, 0]]}"#,
+        )
+        .unwrap();
+        assert!(matches!(
+            read_points(&p, &ReadOptions::DEFAULT),
+            Err(IoError::CurveNotPoints { .. })
+        ));
+        assert_eq!(read_curve_json(&p).unwrap().degree(), 2);
+        let csv = dir.join("c.csv");
+        fs::write(&csv, SQUARE).unwrap();
+        assert!(matches!(
+            read_curve_json(&csv),
+            Err(IoError::UnknownFormat { .. })
+        ));
+        fs::remove_dir_all(&dir).unwrap();
+    }
+}

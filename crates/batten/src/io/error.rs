@@ -1,0 +1,200 @@
+//! [`IoError`]: what can go wrong reading or writing a point file.
+
+use std::path::PathBuf;
+
+use thiserror::Error;
+
+/// An error of the I/O layer. Every variant names the file; those about one place in it also
+/// name the 1-based line, so that the message reads as one line such as
+/// `data.csv:7: field 2 'abc' is not a number`.
+///
+/// Bad input is rejected, never repaired: no rows are dropped, sorted or merged.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum IoError {
+    /// The file could not be opened or read.
+    #[error("{}: cannot read: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// What the operating system said.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file could not be written (or the temporary file beside it could not be created or
+    /// renamed over it).
+    #[error("{}: cannot write: {source}", path.display())]
+    Write {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// What the operating system said.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file name's extension names no supported format.
+    #[error("{}: unknown file format (use a .csv, .txt or .json file name)", path.display())]
+    UnknownFormat {
+        /// The file.
+        path: PathBuf,
+    },
+    /// A line of a text file is not valid UTF-8.
+    #[error("{}:{line}: not valid UTF-8 text", path.display())]
+    NotUtf8 {
+        /// The file.
+        path: PathBuf,
+        /// The 1-based line holding the first invalid byte.
+        line: usize,
+    },
+    /// The file holds no points at all (it is empty, or only comments, blank lines and a
+    /// header; or a JSON `points` array is empty).
+    #[error("{}: no points", path.display())]
+    Empty {
+        /// The file.
+        path: PathBuf,
+    },
+    /// A row (a text line, or one JSON point or tangent) does not have exactly two fields.
+    #[error("{}:{line}: expected 2 fields (x, y), found {found}", path.display())]
+    FieldCount {
+        /// The file.
+        path: PathBuf,
+        /// The 1-based line of the row.
+        line: usize,
+        /// How many fields the row has.
+        found: usize,
+    },
+    /// A field is not a number.
+    #[error("{}:{line}: field {field} '{text}' is not a number", path.display())]
+    NotANumber {
+        /// The file.
+        path: PathBuf,
+        /// The 1-based line of the row.
+        line: usize,
+        /// The 1-based position of the field in the row.
+        field: usize,
+        /// The field as written (control characters escaped, long fields shortened).
+        text: String,
+    },
+    /// A coordinate is NaN or infinite (including numbers too large for an `f64`, which
+    /// parse as infinity).
+    #[error("{}:{line}: NaN or infinite value", path.display())]
+    NonFinite {
+        /// The file.
+        path: PathBuf,
+        /// The 1-based line of the point.
+        line: usize,
+    },
+    /// Fewer points than batten needs ([`crate::PointSeq::MIN_POINTS`]).
+    #[error("{}: {got} points, at least {needed} needed", path.display())]
+    TooFewPoints {
+        /// The file.
+        path: PathBuf,
+        /// How many points the file holds.
+        got: usize,
+        /// The minimum.
+        needed: usize,
+    },
+    /// A point equals the one before it (a zero-length chord).
+    #[error(
+        "{}:{line}: point duplicates the previous one (line {previous})",
+        path.display()
+    )]
+    DuplicatePoint {
+        /// The file.
+        path: PathBuf,
+        /// The 1-based line of the repeated point.
+        line: usize,
+        /// The 1-based line of the point it repeats.
+        previous: usize,
+    },
+    /// A closed curve ends with a copy of its first point. Closed curves are given without
+    /// the repeated point: the closing chord is implied.
+    #[error(
+        "{}:{line}: closed curve repeats its first point (line {first}); leave the repeated point out",
+        path.display()
+    )]
+    RepeatsFirst {
+        /// The file.
+        path: PathBuf,
+        /// The 1-based line of the last point.
+        line: usize,
+        /// The 1-based line of the first point.
+        first: usize,
+    },
+    /// The JSON is malformed or does not have the expected shape. `message` is serde_json's,
+    /// prefixed with "malformed JSON: " for syntax errors.
+    #[error("{}:{line}:{column}: {message}", path.display())]
+    Json {
+        /// The file.
+        path: PathBuf,
+        /// The 1-based line serde_json reported.
+        line: usize,
+        /// The 1-based column serde_json reported.
+        column: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// The JSON is well formed and has the expected keys, but a value is rejected where
+    /// serde_json cannot say where (a B-spline the library refuses, e.g. a knot vector of the
+    /// wrong length).
+    #[error("{}: {message}", path.display())]
+    JsonContent {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// A JSON point list whose `tangents` array has a different length than `points`.
+    #[error("{}: {got} tangents for {expected} points", path.display())]
+    TangentCount {
+        /// The file.
+        path: PathBuf,
+        /// Number of tangents.
+        got: usize,
+        /// Number of points.
+        expected: usize,
+    },
+    /// A point list was asked for, but the JSON file holds a B-spline curve.
+    #[error(
+        "{}: the file holds a B-spline curve (degree, knots, control_points), not a point list",
+        path.display()
+    )]
+    CurveNotPoints {
+        /// The file.
+        path: PathBuf,
+    },
+    /// A B-spline curve was asked for, but the JSON file holds a point list.
+    #[error("{}: the file holds a point list, not a B-spline curve", path.display())]
+    PointsNotCurve {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The data parsed, but the library rejected it for a reason that has no single line.
+    #[error("{}: {source}", path.display())]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// The library's reason.
+        #[source]
+        source: crate::Error,
+    },
+    /// A point to be written is NaN or infinite; it could not be read back.
+    #[error("{}: cannot write point {index}: NaN or infinite value", path.display())]
+    NonFiniteOutput {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// The 0-based index of the point (or tangent).
+        index: usize,
+    },
+    /// The output path is the input file (after resolving links), which is never overwritten.
+    #[error(
+        "refusing to write {}: it is the input file {}",
+        output.display(),
+        input.display()
+    )]
+    SameFile {
+        /// The input path as given.
+        input: PathBuf,
+        /// The output path as given.
+        output: PathBuf,
+    },
+}

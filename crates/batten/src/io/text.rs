@@ -1,0 +1,361 @@
+//! Point lists as text: one `x,y` per line (`.csv`, `.txt`).
+//!
+//! # Reading
+//!
+//! A hand parser, not the `csv` crate: the format mixes things `csv` does not do (separators
+//! chosen per line among comma, semicolon and runs of whitespace; trailing `#` comments), and
+//! the parser must know the physical line of every point to report errors. Rules, per line:
+//!
+//! 1. Everything from the first `#` on is a comment. What is left is trimmed; an empty line is
+//!    skipped.
+//! 2. Fields are separated by `;` if the line has one, else by `,` if it has one, else by runs
+//!    of spaces and tabs. Each field is trimmed, and one pair of surrounding double quotes is
+//!    removed (spreadsheets quote numbers). Empty fields count (`1,2,` has three fields).
+//! 3. The first non-empty line is a header, and skipped, when *none* of its fields is a number
+//!    (`x,y`, `X Y`). Any later non-numeric field is an error.
+//! 4. Every other line has exactly two fields, each a number as Rust's `f64::from_str` reads
+//!    it (`1`, `-2.5`, `1e-300`, `.5`). `NaN`, `inf` and numbers too large for an `f64` are
+//!    errors, as are decimal commas (`1,5;2,5` is a row of two non-numbers).
+//!
+//! Line numbers are physical lines, 1-based; `\r\n` endings are accepted, and a UTF-8 byte
+//! order mark at the start is ignored.
+//!
+//! # Writing
+//!
+//! A header `x,y`, then one `x,y` row per point, with numbers in the shortest form that reads
+//! back to the same `f64` bit for bit (see [`format_f64`]).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::IoError;
+use crate::geom::Point;
+
+/// Longest field text echoed in an error message, in characters.
+const MAX_ECHO_CHARS: usize = 40;
+
+/// Points and the 1-based line each came from.
+pub(crate) struct ParsedText {
+    pub points: Vec<Point>,
+    pub lines: Vec<usize>,
+}
+
+/// Parse the text format. `path` is only used in error messages.
+pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<ParsedText, IoError> {
+    let text = std::str::from_utf8(bytes).map_err(|e| IoError::NotUtf8 {
+        path: path.to_path_buf(),
+        line: 1 + bytes[..e.valid_up_to()]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count(),
+    })?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+
+    let mut points = Vec::new();
+    let mut lines = Vec::new();
+    let mut seen_content = false;
+    for (i, raw) in text.lines().enumerate() {
+        let line = i + 1;
+        let content = match raw.find('#') {
+            Some(k) => &raw[..k],
+            None => raw,
+        }
+        .trim();
+        if content.is_empty() {
+            continue;
+        }
+        let fields = split_fields(content);
+        if !seen_content {
+            seen_content = true;
+            if fields.iter().all(|f| f.parse::<f64>().is_err()) {
+                continue; // the header
+            }
+        }
+        if fields.len() != 2 {
+            return Err(IoError::FieldCount {
+                path: path.to_path_buf(),
+                line,
+                found: fields.len(),
+            });
+        }
+        let mut xy = [0.0; 2];
+        for (k, (field, slot)) in fields.iter().zip(&mut xy).enumerate() {
+            let v = field.parse::<f64>().map_err(|_| IoError::NotANumber {
+                path: path.to_path_buf(),
+                line,
+                field: k + 1,
+                text: echo(field),
+            })?;
+            if !v.is_finite() {
+                return Err(IoError::NonFinite {
+                    path: path.to_path_buf(),
+                    line,
+                });
+            }
+            *slot = v;
+        }
+        points.push(Point::new(xy[0], xy[1]));
+        lines.push(line);
+    }
+    Ok(ParsedText { points, lines })
+}
+
+/// Split a trimmed, comment-free, non-empty line into trimmed, unquoted fields.
+fn split_fields(content: &str) -> Vec<&str> {
+    let fields: Vec<&str> = if content.contains(';') {
+        content.split(';').collect()
+    } else if content.contains(',') {
+        content.split(',').collect()
+    } else {
+        content.split_whitespace().collect()
+    };
+    fields.into_iter().map(|f| unquote(f.trim())).collect()
+}
+
+/// `"1.5"` → `1.5`; anything else unchanged.
+fn unquote(field: &str) -> &str {
+    field
+        .strip_prefix('"')
+        .and_then(|f| f.strip_suffix('"'))
+        .unwrap_or(field)
+}
+
+/// A field as shown in a message: control characters escaped (so the message stays on one
+/// line), at most [`MAX_ECHO_CHARS`] characters.
+fn echo(field: &str) -> String {
+    let mut out = String::new();
+    for (n, c) in field.chars().enumerate() {
+        if n == MAX_ECHO_CHARS {
+            out.push('…');
+            break;
+        }
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// The shortest decimal text that reads back (with `f64::from_str`) as exactly `x`.
+///
+/// Rust's `Display` for `f64` prints the shortest digit string that round-trips, but never
+/// in exponent form, so `1e300` would take 301 characters; `LowerExp` prints the same digits
+/// with an exponent. Numbers of magnitude in `[1e-5, 1e16)` (and zeros) use `Display`
+/// (`0.1`, `-2.5`, `-0`), all others `LowerExp` (`1e300`, `5e-324`). Both are exact.
+/// Non-finite values are the caller's to reject.
+pub fn format_f64(x: f64) -> String {
+    let a = x.abs();
+    if a == 0.0 || (1e-5..1e16).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// The text format of `points`: header `x,y`, one row per point.
+pub(crate) fn format(points: &[Point]) -> String {
+    let mut out = String::with_capacity(16 + points.len() * 40);
+    out.push_str("x,y\n");
+    for p in points {
+        // Writing to a String cannot fail.
+        let _ = writeln!(out, "{},{}", format_f64(p.x), format_f64(p.y));
+    }
+    out
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    fn parse_str(s: &str) -> Result<ParsedText, IoError> {
+        parse(s.as_bytes(), Path::new("data.csv"))
+    }
+
+    fn msg(s: &str) -> String {
+        match parse_str(s) {
+            Ok(_) => panic!("expected an error for {s:?}"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn separators_comments_header() {
+        let p = parse_str(
+            "# a comment\n\nx,y\n0,1\n1;2 # trailing\n  2\t3\n3   4\r\n\"4\",\"5\"\n 5 , 6 \n",
+        )
+        .unwrap();
+        assert_eq!(
+            p.points,
+            vec![
+                Point::new(0.0, 1.0),
+                Point::new(1.0, 2.0),
+                Point::new(2.0, 3.0),
+                Point::new(3.0, 4.0),
+                Point::new(4.0, 5.0),
+                Point::new(5.0, 6.0),
+            ]
+        );
+        assert_eq!(p.lines, vec![4, 5, 6, 7, 8, 9]);
+    }
+
+    #[test]
+    fn header_only_on_first_content_line() {
+        let p = parse_str("# c\nX Y\n1 2\n").unwrap();
+        assert_eq!(p.points, vec![Point::new(1.0, 2.0)]);
+        assert_eq!(
+            msg("x,y\n1,2\nx,y\n"),
+            "data.csv:3: field 1 'x' is not a number"
+        );
+        // A first line with a number in it is data, not a header.
+        assert_eq!(msg("1,abc\n"), "data.csv:1: field 2 'abc' is not a number");
+    }
+
+    #[test]
+    fn byte_order_mark_is_ignored() {
+        let p = parse_str("\u{feff}x,y\n1,2\n").unwrap();
+        assert_eq!(p.points, vec![Point::new(1.0, 2.0)]);
+    }
+
+    #[test]
+    fn empty_and_comment_only_give_no_points() {
+        assert!(parse_str("").unwrap().points.is_empty());
+        assert!(parse_str("# only\n\n   \nx,y\n").unwrap().points.is_empty());
+    }
+
+    #[test]
+    fn bad_rows() {
+        assert_eq!(
+            msg("0,0\n1,2,3\n"),
+            "data.csv:2: expected 2 fields (x, y), found 3"
+        );
+        assert_eq!(
+            msg("0,0\n1\n"),
+            "data.csv:2: expected 2 fields (x, y), found 1"
+        );
+        assert_eq!(
+            msg("0,0\n1,2,\n"),
+            "data.csv:2: expected 2 fields (x, y), found 3"
+        );
+        assert_eq!(
+            msg("0,0\n1,1\n2,2\n3,3\n4,4\n5,6\nabc,7\n"),
+            "data.csv:7: field 1 'abc' is not a number"
+        );
+        assert_eq!(
+            msg("0,0\n1,2\n3,x1\n"),
+            "data.csv:3: field 2 'x1' is not a number"
+        );
+        assert_eq!(
+            msg("0,0\n1;2,5\n"),
+            "data.csv:2: field 2 '2,5' is not a number"
+        );
+        assert_eq!(
+            msg("0,0\n1,1\n2,2\n3,3\nNaN,1\n"),
+            "data.csv:5: NaN or infinite value"
+        );
+        assert_eq!(msg("0,0\n1,inf\n"), "data.csv:2: NaN or infinite value");
+        assert_eq!(
+            msg("0,0\n1,-infinity\n"),
+            "data.csv:2: NaN or infinite value"
+        );
+        assert_eq!(msg("0,0\n1,1e400\n"), "data.csv:2: NaN or infinite value");
+    }
+
+    #[test]
+    fn error_echo_stays_on_one_line_and_short() {
+        let m = msg("0,0\n1,a\u{7}b\n");
+        assert_eq!(m, "data.csv:2: field 2 'a\\u{7}b' is not a number");
+        let long = "z".repeat(100);
+        let m = msg(&format!("0,0\n1,{long}\n"));
+        assert!(m.len() < 100, "{m}");
+        assert!(m.contains('…'));
+    }
+
+    #[test]
+    fn invalid_utf8_names_the_line() {
+        let e = parse(b"x,y\n1,2\n3,\xff\n", Path::new("data.csv"))
+            .err()
+            .map(|e| e.to_string());
+        assert_eq!(e.as_deref(), Some("data.csv:3: not valid UTF-8 text"));
+    }
+
+    /// Values whose text form is hardest: signed zero, extremes, subnormals, and numbers
+    /// with 17 significant digits.
+    fn nasty_values() -> Vec<f64> {
+        let mut v = vec![
+            0.0,
+            -0.0,
+            1e-300,
+            -1e-300,
+            1e300,
+            -1e300,
+            f64::MIN_POSITIVE,
+            f64::MIN_POSITIVE / 3.0,
+            5e-324,
+            -5e-324,
+            f64::from_bits(0x000F_FFFF_FFFF_FFFF), // the largest subnormal
+            f64::MAX,
+            f64::MIN,
+            f64::EPSILON,
+            0.1,
+            1.0 / 3.0,
+            2.0 / 3.0,
+            1e-5,
+            9.999999999999999e-6,
+            1e16,
+            9999999999999998.0,
+            123_456_789.123_456_79,
+            std::f64::consts::PI,
+            -std::f64::consts::E,
+        ];
+        // Random bit patterns (xorshift64), finite only.
+        let mut s: u64 = 0x9E37_79B9_7F4A_7C15;
+        while v.len() < 20_000 {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            let x = f64::from_bits(s);
+            if x.is_finite() {
+                v.push(x);
+            }
+        }
+        v
+    }
+
+    #[test]
+    fn format_f64_round_trips_bit_exact() {
+        for x in nasty_values() {
+            let t = format_f64(x);
+            let y: f64 = t.parse().unwrap();
+            assert_eq!(x.to_bits(), y.to_bits(), "{x:e} written as {t}");
+            assert!(t.len() <= 24, "{t} is not short");
+        }
+        assert_eq!(format_f64(-0.0), "-0");
+        assert_eq!(format_f64(1e300), "1e300");
+        assert_eq!(format_f64(1e-300), "1e-300");
+        assert_eq!(format_f64(5e-324), "5e-324");
+        assert_eq!(format_f64(0.1), "0.1");
+        assert_eq!(format_f64(-2.5), "-2.5");
+    }
+
+    #[test]
+    fn format_then_parse_is_identity() {
+        let vals = nasty_values();
+        // Pairs of distinct consecutive values: a file does not need them, the format does.
+        let points: Vec<Point> = vals
+            .chunks_exact(2)
+            .map(|c| Point::new(c[0], c[1]))
+            .collect();
+        let text = format(&points);
+        assert!(text.starts_with("x,y\n"));
+        let back = parse_str(&text).unwrap();
+        assert_eq!(back.points.len(), points.len());
+        for (a, b) in points.iter().zip(&back.points) {
+            assert_eq!(a.x.to_bits(), b.x.to_bits());
+            assert_eq!(a.y.to_bits(), b.y.to_bits());
+        }
+        assert_eq!(back.lines[0], 2);
+    }
+}
