@@ -8,12 +8,14 @@
 //! Nothing here knows about fairing.
 
 mod bspline;
+mod bspline_ops;
 mod function;
 mod interpolate;
 mod knots;
 mod parametric;
 
 pub use bspline::{BSplineCurve, MAX_ORDER};
+pub use bspline_ops::{DEVIATION_SAMPLES_PER_SPAN, KnotRef, KnotRemoval, RemovalRule};
 pub use function::{CubicSplineFn, FnEndCondition};
 pub use knots::KnotVector;
 pub use parametric::{EndCondition, ParametricCubic, Parametrization, parameters};
