@@ -18,7 +18,7 @@ use std::time::Instant;
 
 pub use options::{FairOptions, ParamSpec};
 pub use report::{FairReport, FairStatus, HistoryRow, Move};
-pub use smoothing::Mst;
+pub use smoothing::{Mst, Smoothing, SmoothingInfo, SmoothingSpline, SmoothingTrial};
 
 use crate::analysis::{FairnessMetrics, displacement};
 use crate::error::{Error, Result};

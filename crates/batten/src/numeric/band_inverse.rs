@@ -13,22 +13,19 @@
 //! spline's influence matrix (generalised cross-validation) needs.
 
 use super::SymBanded;
-use crate::error::{Error, Result};
+use crate::error::Result;
 
-/// The entries of `A⁻¹` inside the band of `A` (`|i − j| ≤ bw`), for a matrix that has been
-/// factorised with [`SymBanded::factorize`]. The result is returned as a (not factorised)
+/// Factorise `a` in place (as [`SymBanded::factorize`], so it can solve afterwards) and return
+/// the entries of `A⁻¹` inside the band of `A` (`|i − j| ≤ bw`), as a (not factorised)
 /// [`SymBanded`] of the same size and bandwidth; read it with [`SymBanded::get`]. Entries of
 /// `A⁻¹` outside the band are not computed (they are not zero in general).
 ///
+/// `a` must not have been factorised before.
+///
 /// # Errors
-/// [`Error::InvalidParameter`] when `a` has not been factorised.
-pub fn inverse_band(a: &SymBanded) -> Result<SymBanded> {
-    if !a.is_factored() {
-        return Err(Error::InvalidParameter {
-            name: "SymBanded".into(),
-            reason: "inverse_band needs a factorised matrix".into(),
-        });
-    }
+/// [`Error::Singular`] from the factorisation.
+pub fn factorize_with_inverse_band(a: &mut SymBanded) -> Result<SymBanded> {
+    a.factorize()?;
     let (n, bw) = (a.n(), a.bandwidth());
     let mut s = SymBanded::zeros(n, bw);
     for c in (0..n).rev() {
@@ -51,6 +48,7 @@ pub fn inverse_band(a: &SymBanded) -> Result<SymBanded> {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 
@@ -72,8 +70,7 @@ mod tests {
                     dense[(i - k, i)] = v;
                 }
             }
-            a.factorize().unwrap();
-            let s = inverse_band(&a).unwrap();
+            let s = factorize_with_inverse_band(&mut a).unwrap();
             let inv = dense.try_inverse().unwrap();
             for i in 0..n {
                 for j in i.saturating_sub(bw)..=i {
@@ -87,8 +84,11 @@ mod tests {
     }
 
     #[test]
-    fn unfactored_is_rejected() {
-        let a = SymBanded::zeros(3, 1);
-        assert!(inverse_band(&a).is_err());
+    fn indefinite_is_rejected() {
+        let mut a = SymBanded::zeros(2, 1);
+        a.add(0, 0, 1.0);
+        a.add(1, 0, 2.0);
+        a.add(1, 1, 1.0);
+        assert!(factorize_with_inverse_band(&mut a).is_err());
     }
 }

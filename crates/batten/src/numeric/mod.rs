@@ -2,7 +2,9 @@
 //! Gauss–Legendre quadrature, bracketing 1-D minimisers.
 
 mod band_lu;
+mod band_inverse;
 mod banded;
+mod cyclic_banded;
 mod minimize;
 mod quadrature;
 mod tridiagonal;
@@ -10,7 +12,9 @@ mod tridiagonal;
 use std::ops::{Add, Mul, Sub};
 
 pub use band_lu::BandLu;
+pub use band_inverse::factorize_with_inverse_band;
 pub use banded::SymBanded;
+pub use cyclic_banded::CyclicSymBanded;
 pub use minimize::{Minimum, minimize_brent, minimize_golden};
 pub use quadrature::GaussLegendre;
 pub use tridiagonal::{solve_cyclic_tridiagonal, solve_tridiagonal};

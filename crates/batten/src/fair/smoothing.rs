@@ -1,0 +1,1104 @@
+//! `mst`: the cubic smoothing spline, the global baseline that Han et al.
+//! (`../shared/papers/han-explicit-fairing-indicator.txt`, §5) call MST — Matlab's `csaps`.
+//!
+//! # The problem
+//!
+//! For points `P_0..P_{n−1}` at chord-length parameters `t_i` (spec §0.2) and weights `w_i`,
+//! find the C² cubic spline curve `C` with knots `t_i` that minimises
+//!
+//! ```text
+//! p · Σ_i w_i |P_i − C(t_i)|²  +  (1 − p) · ∫ |C''(t)|² dt ,        p ∈ [0, 1],
+//! ```
+//!
+//! the objective of Matlab's and PyPI's `csaps` (Han et al. write `λE_d + (1 − λ)E_s`). Both
+//! coordinates share the parameter and the matrix, so one factorisation serves x and y. The
+//! minimiser is the natural cubic spline (`C'' = 0` at the ends) of its own values
+//! `g_i = C(t_i)`; a closed curve gives the periodic spline.
+//!
+//! # The algorithm (Reinsch 1967; de Boor, *A Practical Guide to Splines*, ch. XIV, `SMOOTH`)
+//!
+//! With `h_i = t_{i+1} − t_i`, `γ_k = C''(t_k)` at the interior knots (all knots when closed),
+//! `Q` the n×m matrix of second divided differences (column k: `1/h_{k−1}`,
+//! `−(1/h_{k−1} + 1/h_k)`, `1/h_k` in rows k−1, k, k+1), `R` the tridiagonal m×m matrix
+//! (`(h_{k−1} + h_k)/3` on the diagonal, `h_k/6` beside it) and `W⁻¹ = diag(1/w_i)`:
+//!
+//! ```text
+//! (R + α Qᵀ W⁻¹ Q) γ = Qᵀ y,     g = y − α W⁻¹ Q γ,     α = (1 − p)/p.
+//! ```
+//!
+//! We solve the equivalent scaled form `(p R + (1 − p) Qᵀ W⁻¹ Q) u = Qᵀ y`, `γ = p·u`,
+//! `g = y − (1 − p) W⁻¹ Q u` — csaps's system divided by 6 — whose coefficients stay in
+//! `[0, 1]` for every α (`p = 1/(1 + α)`, `1 − p = α/(1 + α)`, each computed without
+//! cancellation). The matrix is symmetric positive definite and pentadiagonal (cyclic
+//! pentadiagonal when closed): [`SymBanded`] `L D Lᵀ` in O(n) for open curves,
+//! [`CyclicSymBanded`] (envelope `L D Lᵀ`, also O(n)) for closed ones.
+//!
+//! **Infinite weights** pin a point: `W⁻¹_ii = 0`, so `g_i = y_i` exactly. `fix_ends` pins the
+//! first and last points of an open curve. The matrix stays SPD because `R` is SPD for any
+//! weights (and `p > 0`).
+//!
+//! **p = 0** (`α = ∞`) is the limit, solved directly: the weighted least-squares straight line
+//! in t (through the pinned point, or the line through the two pinned points, when there are
+//! pins). A closed curve would collapse to a point, so p = 0 is rejected for it.
+//!
+//! # Choosing p
+//!
+//! - `--set p=<value>`: that p.
+//! - `--tolerance D` without p: the smoothest spline whose largest displacement is at most D.
+//!   Bisection on `ln α` (a well-conditioned variable: the smoothing bandwidth grows like
+//!   `α^{1/4}`) until the bracket is narrower than [`BISECTION_REL_PRECISION`] in α; the
+//!   feasible end of the bracket is returned, so the tolerance always holds (`p = 1`
+//!   interpolates with zero displacement, the fallback). For an open curve the least-squares
+//!   line is tried first.
+//! - neither: generalised cross-validation (Craven & Wahba 1979),
+//!   `GCV(α) = n·RSS / tr(I − A)²`, RSS summed over x and y, `A` the influence matrix
+//!   `g = A y`. `tr(I − A) = (1 − p)·Σ_i W⁻¹_ii q_iᵀ M⁻¹ q_i` (`q_i` row i of Q, M the scaled
+//!   matrix) needs only the band of `M⁻¹`, from the `L D Lᵀ` factors by the recursion of
+//!   Hutchinson & de Hoog (1985) in O(n). Minimised over `ln α` by a coarse scan then
+//!   [`minimize_brent`] (GCV can have several local minima).
+//!
+//! Scale: p is not scale invariant (the two terms of the objective have different units);
+//! this is csaps's convention and is kept for parity. The searches work relative to
+//! `α_ref = tr R / tr(Qᵀ W⁻¹ Q)`, csaps's default ([`SmoothingSpline::default_p`]), and so
+//! behave the same at every scale.
+
+use serde_json::{Map, Value};
+
+use super::{FairMethod, FairOptions, FairStatus, HistoryRow, Outcome, ParamSpec};
+use crate::error::{Error, Result};
+use crate::geom::{Point, PointSeq, Vec2};
+use crate::numeric::{CyclicSymBanded, SymBanded, factorize_with_inverse_band, minimize_brent};
+use crate::spline::{ParametricCubic, Parametrization, parameters};
+
+/// The bisection on `ln α` (tolerance mode) stops when the bracket `[α_lo, α_hi]` satisfies
+/// `α_hi / α_lo ≤ 1 + BISECTION_REL_PRECISION`.
+pub const BISECTION_REL_PRECISION: f64 = 1e-3;
+
+/// Default limit on bisection steps in tolerance mode (`max_iterations` overrides it). The
+/// bracket is about 90 units of `ln α` wide at n = 10⁶, so ~17 steps reach
+/// [`BISECTION_REL_PRECISION`]; the default leaves ample room.
+pub const DEFAULT_MAX_BISECTION_STEPS: usize = 60;
+
+/// The searches start `LOG_ALPHA_BELOW` units of `ln α` below `ln α_ref`: at `α = α_ref·e⁻²⁵`
+/// the spline interpolates to about 10⁻¹¹ of the data's roughness.
+const LOG_ALPHA_BELOW: f64 = 25.0;
+
+/// The searches end `4 ln n + LOG_ALPHA_ABOVE` units of `ln α` above `ln α_ref`: the smoothing
+/// bandwidth (in points) grows like `(α/α_ref)^{1/4}`, so there it spans ~e² n points and the
+/// spline is the least-squares line to plotting accuracy.
+const LOG_ALPHA_ABOVE: f64 = 8.0;
+
+/// Step of the coarse GCV scan in `ln α` (a factor e² ≈ 7.4 in α, 1.65 in bandwidth).
+const GCV_SCAN_STEP: f64 = 2.0;
+
+/// Brent refinement of the GCV minimum: absolute tolerance in `ln α`.
+const GCV_LOG_ALPHA_TOL: f64 = 1e-4;
+
+/// Brent refinement of the GCV minimum: evaluation budget.
+const GCV_MAX_EVALUATIONS: usize = 60;
+
+/// How the smoothing parameter is chosen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum Smoothing {
+    /// The given `p ∈ [0, 1]` (1 interpolates, 0 is the least-squares line).
+    P(f64),
+    /// The smoothest spline (largest α) with every `|g_i − P_i| ≤ tolerance`, by bisection on
+    /// `ln α` with at most `max_steps` steps.
+    MaxDisplacement {
+        /// The largest allowed displacement, data units.
+        tolerance: f64,
+        /// Bisection step limit.
+        max_steps: usize,
+    },
+    /// Generalised cross-validation.
+    Gcv,
+}
+
+/// One spline computed during a search (the trace behind [`SmoothingInfo::trials`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SmoothingTrial {
+    /// The smoothing parameter.
+    pub p: f64,
+    /// `α = (1 − p)/p` (infinite for p = 0).
+    pub alpha: f64,
+    /// Largest `|g_i − P_i|`.
+    pub max_displacement: f64,
+    /// `∫ |C''|² dt`.
+    pub roughness: f64,
+    /// The GCV score, when computed.
+    pub gcv: Option<f64>,
+}
+
+/// How p was chosen and what the search saw.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SmoothingInfo {
+    /// The smoothing parameter used.
+    pub p: f64,
+    /// `α = (1 − p)/p` (infinite for p = 0).
+    pub alpha: f64,
+    /// The GCV score of the result (GCV mode only).
+    pub gcv: Option<f64>,
+    /// `tr A`, the equivalent degrees of freedom per coordinate (GCV mode only).
+    pub degrees_of_freedom: Option<f64>,
+    /// Splines computed by the search, in order (empty for a given p).
+    pub trials: Vec<SmoothingTrial>,
+    /// Whether the search reached its precision (always true for a given p).
+    pub converged: bool,
+    /// Remarks (e.g. that the tolerance is so small that the result interpolates).
+    pub notes: Vec<String>,
+}
+
+/// A fitted cubic smoothing spline: the smoothed values at the data parameters and the second
+/// derivatives there, which together define the natural (or periodic) cubic spline.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SmoothingSpline {
+    t: Vec<f64>,
+    values: Vec<Point>,
+    second: Vec<Vec2>,
+    p: f64,
+    alpha: f64,
+    closed: bool,
+}
+
+impl SmoothingSpline {
+    /// The smoothing spline of an open point sequence at parameters `t` (strictly increasing,
+    /// one per point) with smoothing parameter `p ∈ [0, 1]`.
+    ///
+    /// `weights`: one per point, positive; `f64::INFINITY` pins a point. `None`: all 1.
+    ///
+    /// # Errors
+    /// [`Error::TooFewPoints`] (fewer than 2), [`Error::LengthMismatch`],
+    /// [`Error::NotIncreasing`], [`Error::NonFinite`], [`Error::InvalidParameter`] for p or a
+    /// weight out of range (or p = 0 with more than two pinned points), [`Error::Singular`]
+    /// when the system is numerically singular (extreme p on extreme data).
+    pub fn fit(
+        t: &[f64],
+        points: &[Point],
+        weights: Option<&[f64]>,
+        p: f64,
+    ) -> Result<SmoothingSpline> {
+        Ok(Self::select(t, points, weights, false, Smoothing::P(p))?.0)
+    }
+
+    /// The periodic smoothing spline of a closed point sequence: `t` has one more entry than
+    /// `points`, the parameter at which the curve returns to `P_0` (as
+    /// [`parameters`]`(…, closed = true)` returns). `p` must be in `(0, 1]`.
+    ///
+    /// # Errors
+    /// As [`SmoothingSpline::fit`]; [`Error::TooFewPoints`] for fewer than 3 points.
+    pub fn fit_periodic(
+        t: &[f64],
+        points: &[Point],
+        weights: Option<&[f64]>,
+        p: f64,
+    ) -> Result<SmoothingSpline> {
+        Ok(Self::select(t, points, weights, true, Smoothing::P(p))?.0)
+    }
+
+    /// The smoothing spline with p chosen as `how` says; see [`SmoothingSpline::fit`] and
+    /// [`SmoothingSpline::fit_periodic`] for `t`, `weights` and `closed`.
+    ///
+    /// # Errors
+    /// As [`SmoothingSpline::fit`]; [`Error::InvalidParameter`] for a tolerance that is not
+    /// positive and finite; [`Error::TooFewPoints`] for GCV on fewer than 3 points;
+    /// [`Error::NoConvergence`] when no trial of the GCV search could be solved.
+    pub fn select(
+        t: &[f64],
+        points: &[Point],
+        weights: Option<&[f64]>,
+        closed: bool,
+        how: Smoothing,
+    ) -> Result<(SmoothingSpline, SmoothingInfo)> {
+        let problem = Problem::new(t, points, weights, closed)?;
+        match how {
+            Smoothing::P(p) => {
+                check_p(p, closed)?;
+                let fit = problem.fit_p(p)?;
+                let info = SmoothingInfo {
+                    p,
+                    alpha: fit.alpha,
+                    gcv: None,
+                    degrees_of_freedom: None,
+                    trials: Vec::new(),
+                    converged: true,
+                    notes: Vec::new(),
+                };
+                Ok((problem.into_spline(fit), info))
+            }
+            Smoothing::MaxDisplacement {
+                tolerance,
+                max_steps,
+            } => {
+                if !(tolerance.is_finite() && tolerance > 0.0) {
+                    return Err(Error::InvalidParameter {
+                        name: "tolerance".into(),
+                        reason: format!("must be a positive finite number, got {tolerance}"),
+                    });
+                }
+                problem.search_tolerance(tolerance, max_steps)
+            }
+            Smoothing::Gcv => problem.search_gcv(),
+        }
+    }
+
+    /// csaps's default smoothing parameter for these parameters and weights:
+    /// `p = 1 / (1 + tr R / tr(Qᵀ W⁻¹ Q))`, which balances the traces of the two terms
+    /// (`1/(1 + tr(A)/(6 tr(B)))` in csaps's scaling). `t` has one entry per point for an open
+    /// curve and one more for a closed one.
+    ///
+    /// # Errors
+    /// As [`SmoothingSpline::select`]; [`Error::Degenerate`] when every point is pinned.
+    pub fn default_p(t: &[f64], weights: &[f64], closed: bool) -> Result<f64> {
+        let n = if closed {
+            t.len().saturating_sub(1)
+        } else {
+            t.len()
+        };
+        let dummy: Vec<Point> = vec![Point::ORIGIN; n];
+        let problem = Problem::new(t, &dummy, Some(weights), closed)?;
+        let alpha = problem.alpha_ref()?;
+        Ok(1.0 / (1.0 + alpha))
+    }
+
+    /// The smoothed points `g_i = C(t_i)`, same count and order as the data.
+    pub fn values(&self) -> &[Point] {
+        &self.values
+    }
+
+    /// Consume the spline and return the smoothed points.
+    pub fn into_values(self) -> Vec<Point> {
+        self.values
+    }
+
+    /// The second derivatives `C''(t_i)` at the data parameters (zero at the ends of an open
+    /// curve).
+    pub fn second_derivatives(&self) -> &[Vec2] {
+        &self.second
+    }
+
+    /// The parameters (one more than points for a closed curve).
+    pub fn knots(&self) -> &[f64] {
+        &self.t
+    }
+
+    /// The smoothing parameter.
+    pub fn p(&self) -> f64 {
+        self.p
+    }
+
+    /// `α = (1 − p)/p`, the weight of the roughness term relative to the data term
+    /// (infinite for p = 0).
+    pub fn alpha(&self) -> f64 {
+        self.alpha
+    }
+
+    /// Whether this is the periodic spline of a closed curve.
+    pub fn is_closed(&self) -> bool {
+        self.closed
+    }
+
+    /// The roughness `∫ |C''(t)|² dt` (exact: C'' is piecewise linear).
+    pub fn roughness(&self) -> f64 {
+        roughness(&self.t, &self.second, self.closed)
+    }
+
+    /// The spline itself, as a [`ParametricCubic`] through the smoothed values with the
+    /// spline's own tangents (so it is the C² natural or periodic spline exactly, not a new
+    /// interpolation). A closed curve is returned with `P_0` repeated at the end, as
+    /// [`ParametricCubic::from_hermite`] takes closed Hermite data.
+    ///
+    /// # Errors
+    /// Those of [`ParametricCubic::from_hermite`] (not expected for a fitted spline).
+    pub fn curve(&self) -> Result<ParametricCubic> {
+        let n = self.values.len();
+        let spans = if self.closed { n } else { n - 1 };
+        let at = |i: usize| if i == n { 0 } else { i };
+        let mut tangents = Vec::with_capacity(spans + 1);
+        for i in 0..spans {
+            let h = self.t[i + 1] - self.t[i];
+            let (g0, g1) = (self.values[i], self.values[at(i + 1)]);
+            let (c0, c1) = (self.second[i], self.second[at(i + 1)]);
+            tangents.push((g1 - g0) / h - (c0 * 2.0 + c1) * (h / 6.0));
+        }
+        // The derivative at the end of the last span.
+        let i = spans - 1;
+        let h = self.t[i + 1] - self.t[i];
+        let (g0, g1) = (self.values[i], self.values[at(i + 1)]);
+        let (c0, c1) = (self.second[i], self.second[at(i + 1)]);
+        tangents.push((g1 - g0) / h + (c0 + c1 * 2.0) * (h / 6.0));
+        let mut pts = self.values.clone();
+        if self.closed {
+            pts.push(self.values[0]);
+        }
+        ParametricCubic::from_hermite(self.t.clone(), pts, tangents)
+    }
+}
+
+/// The largest `|g_i − y_i|`, measured as the fairing report measures it.
+fn max_displacement(y: &[Point], g: &[Point]) -> f64 {
+    y.iter()
+        .zip(g)
+        .map(|(a, b)| (*b - *a).length())
+        .fold(0.0, f64::max)
+}
+
+/// `α = (1 − p)/p`.
+fn alpha_of(p: f64) -> f64 {
+    if p == 0.0 {
+        f64::INFINITY
+    } else {
+        (1.0 - p) / p
+    }
+}
+
+fn check_p(p: f64, closed: bool) -> Result<()> {
+    if !(0.0..=1.0).contains(&p) {
+        return Err(Error::InvalidParameter {
+            name: "p".into(),
+            reason: format!("{p} is outside [0, 1]"),
+        });
+    }
+    if closed && p == 0.0 {
+        return Err(Error::InvalidParameter {
+            name: "p".into(),
+            reason: "p = 0 collapses a closed curve to a point; use p > 0".into(),
+        });
+    }
+    Ok(())
+}
+
+/// `∫ |C''|² dt` for C'' piecewise linear through `second` at the knots `t`.
+fn roughness(t: &[f64], second: &[Vec2], closed: bool) -> f64 {
+    let n = second.len();
+    let spans = if closed { n } else { n.saturating_sub(1) };
+    (0..spans)
+        .map(|i| {
+            let (a, b) = (second[i], second[(i + 1) % n]);
+            (t[i + 1] - t[i]) * (a.dot(a) + a.dot(b) + b.dot(b)) / 3.0
+        })
+        .sum()
+}
+
+/// One solved spline: the fitted values, `u` (with `γ = p·u`) at every knot, and the
+/// quantities the searches need.
+struct Fit {
+    p: f64,
+    /// `α = (1 − p)/p` as used (kept apart from p, which rounds to 1 for tiny α).
+    alpha: f64,
+    values: Vec<Point>,
+    /// `C''(t_k)` at every knot.
+    second: Vec<Vec2>,
+    /// `Σ w_i |y_i − g_i|²` (GCV only).
+    rss: f64,
+    /// `tr(I − A)` (GCV only).
+    trace_residual: f64,
+}
+
+/// The data of one smoothing problem, validated, with what every trial shares.
+struct Problem<'a> {
+    t: &'a [f64],
+    y: &'a [Point],
+    closed: bool,
+    /// `W⁻¹_ii` (0 for a pinned point); `None` for unit weights.
+    dinv: Option<Vec<f64>>,
+    /// Reciprocal span lengths `1/h_k`: n − 1 (open) or n (closed).
+    ih: Vec<f64>,
+}
+
+impl<'a> Problem<'a> {
+    fn new(
+        t: &'a [f64],
+        y: &'a [Point],
+        weights: Option<&[f64]>,
+        closed: bool,
+    ) -> Result<Problem<'a>> {
+        let n = y.len();
+        let min = if closed { 3 } else { 2 };
+        if n < min {
+            return Err(Error::TooFewPoints {
+                needed: min,
+                got: n,
+            });
+        }
+        let nt = if closed { n + 1 } else { n };
+        if t.len() != nt {
+            return Err(Error::LengthMismatch {
+                what: "parameters",
+                got: t.len(),
+                expected: nt,
+            });
+        }
+        if let Some(index) = t.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NonFinite { index });
+        }
+        if let Some(i) = t.windows(2).position(|w| w[1] <= w[0]) {
+            return Err(Error::NotIncreasing { index: i + 1 });
+        }
+        if let Some(index) = y.iter().position(|p| !p.is_finite()) {
+            return Err(Error::NonFinite { index });
+        }
+        let dinv = match weights {
+            None => None,
+            Some(w) => {
+                if w.len() != n {
+                    return Err(Error::LengthMismatch {
+                        what: "weights",
+                        got: w.len(),
+                        expected: n,
+                    });
+                }
+                if let Some(i) = w.iter().position(|&v| v.is_nan() || v <= 0.0) {
+                    return Err(Error::InvalidParameter {
+                        name: "weights".into(),
+                        reason: format!("weight {i} is {}, must be positive", w[i]),
+                    });
+                }
+                Some(w.iter().map(|&v| 1.0 / v).collect())
+            }
+        };
+        let ih: Vec<f64> = t.windows(2).map(|w| 1.0 / (w[1] - w[0])).collect();
+        Ok(Problem {
+            t,
+            y,
+            closed,
+            dinv,
+            ih,
+        })
+    }
+
+    /// `W⁻¹_ii`.
+    #[inline]
+    fn d(&self, i: usize) -> f64 {
+        self.dinv.as_ref().map_or(1.0, |d| d[i])
+    }
+
+    /// The length of span k, `h_k = t_{k+1} − t_k`.
+    #[inline]
+    fn span(&self, k: usize) -> f64 {
+        self.t[k + 1] - self.t[k]
+    }
+
+    /// `(Qᵀ y)` at knot k: the jump of the divided differences.
+    #[inline]
+    fn qty(&self, k: usize) -> Vec2 {
+        let (km, kp) = (self.prev(k), self.next(k));
+        (self.y[kp] - self.y[k]) * self.ih[k] - (self.y[k] - self.y[km]) * self.ih[km]
+    }
+
+    fn n(&self) -> usize {
+        self.y.len()
+    }
+
+    /// Number of unknowns (second derivatives not fixed by the end conditions).
+    fn m(&self) -> usize {
+        if self.closed { self.n() } else { self.n() - 2 }
+    }
+
+    /// The knot of unknown `j`.
+    #[inline]
+    fn knot(&self, j: usize) -> usize {
+        if self.closed { j } else { j + 1 }
+    }
+
+    /// The knot (and span) before knot `k` (cyclically when closed). Only called for `k ≥ 1`
+    /// on open curves.
+    #[inline]
+    fn prev(&self, k: usize) -> usize {
+        if k == 0 { self.n() - 1 } else { k - 1 }
+    }
+
+    /// The knot after knot `k` (cyclically when closed).
+    #[inline]
+    fn next(&self, k: usize) -> usize {
+        if k + 1 == self.n() { 0 } else { k + 1 }
+    }
+
+    /// `tr R / tr(Qᵀ W⁻¹ Q)`: csaps's default α and the centre of the searches.
+    fn alpha_ref(&self) -> Result<f64> {
+        let (mut tr_r, mut tr_n) = (0.0, 0.0);
+        for j in 0..self.m() {
+            let k = self.knot(j);
+            let (km, kp) = (self.prev(k), self.next(k));
+            tr_r += (self.span(km) + self.span(k)) / 3.0;
+            let s = self.ih[km] + self.ih[k];
+            tr_n += self.d(km) * self.ih[km] * self.ih[km]
+                + self.d(k) * s * s
+                + self.d(kp) * self.ih[k] * self.ih[k];
+        }
+        let alpha = tr_r / tr_n;
+        if alpha.is_finite() && alpha > 0.0 {
+            Ok(alpha)
+        } else {
+            Err(Error::Degenerate(
+                "no roughness/data balance: every point is pinned or there are no interior knots"
+                    .into(),
+            ))
+        }
+    }
+
+    /// The entries `(k,k)`, `(k,k+1)`, `(k,k+2)` of `a R + b Qᵀ W⁻¹ Q` at knot k.
+    #[inline]
+    fn entries(&self, k: usize, a: f64, b: f64) -> [f64; 3] {
+        let (km, kp) = (self.prev(k), self.next(k));
+        let (ihm, ihp) = (self.ih[km], self.ih[k]);
+        let s = ihm + ihp;
+        let (dm, d, dp) = (self.d(km), self.d(k), self.d(kp));
+        let d0 = a * (self.span(km) + self.span(k)) / 3.0
+            + b * (dm * ihm * ihm + d * s * s + dp * ihp * ihp);
+        // Span k+1 exists whenever knot k+1 is an unknown.
+        let ihpp = if self.closed || kp < self.n() - 1 {
+            self.ih[kp]
+        } else {
+            0.0
+        };
+        let d1 = a * self.span(k) / 6.0 - b * ihp * (d * s + dp * (ihp + ihpp));
+        let d2 = b * dp * ihp * ihpp;
+        [d0, d1, d2]
+    }
+
+    /// Solve for `p ∈ [0, 1]` (p = 0 by the least-squares line on open curves).
+    fn fit_p(&self, p: f64) -> Result<Fit> {
+        if p == 0.0 {
+            self.fit_line()
+        } else {
+            self.solve(p, 1.0 - p, alpha_of(p), false)
+        }
+    }
+
+    /// Solve for `α` given on a log scale, `α = α_ref · e^s`.
+    fn fit_log_alpha(&self, alpha_ref: f64, s: f64, gcv: bool) -> Result<Fit> {
+        let alpha = alpha_ref * s.exp();
+        self.solve(1.0 / (1.0 + alpha), alpha / (1.0 + alpha), alpha, gcv)
+    }
+
+    /// The spline for the scaled system `(a R + b Qᵀ W⁻¹ Q) u = Qᵀ y` (`a = p`, `b = 1 − p`,
+    /// `alpha = b/a` computed by the caller without rounding p);
+    /// with `gcv`, also RSS and `tr(I − A)`.
+    fn solve(&self, a: f64, b: f64, alpha: f64, gcv: bool) -> Result<Fit> {
+        let (n, m) = (self.n(), self.m());
+        // u at every knot; the open ends stay 0 (natural end conditions).
+        let mut u = vec![Vec2::ZERO; n];
+        let mut trace_residual = 0.0;
+        if self.closed {
+            let mut mat = CyclicSymBanded::zeros(m, 2);
+            for (k, uk) in u.iter_mut().enumerate() {
+                *uk = self.qty(k);
+                let [d0, d1, d2] = self.entries(k, a, b);
+                mat.add(k, k, d0);
+                mat.add(k, (k + 1) % m, d1);
+                mat.add(k, (k + 2) % m, d2);
+            }
+            if gcv {
+                let inv = mat.factorize_with_inverse()?;
+                trace_residual = b * self.trace_term(|i, j| inv.get(i, j));
+            } else {
+                mat.factorize()?;
+            }
+            mat.solve_in_place(&mut u)?;
+        } else {
+            let mut mat = SymBanded::zeros(m, 2);
+            for j in 0..m {
+                u[j + 1] = self.qty(j + 1);
+                let [d0, d1, d2] = self.entries(j + 1, a, b);
+                mat.add(j, j, d0);
+                if j + 1 < m {
+                    mat.add(j + 1, j, d1);
+                }
+                if j + 2 < m {
+                    mat.add(j + 2, j, d2);
+                }
+            }
+            if gcv {
+                let inv = factorize_with_inverse_band(&mut mat)?;
+                trace_residual = b * self.trace_term(|i, j| inv.get(i - 1, j - 1));
+            } else {
+                mat.factorize()?;
+            }
+            mat.solve_in_place(&mut u[1..n - 1])?;
+        }
+        let mut values = Vec::with_capacity(n);
+        let mut rss = 0.0;
+        for i in 0..n {
+            let qu = self.q_row_times(&u, i);
+            let di = self.d(i);
+            values.push(self.y[i] - qu * (b * di));
+            if gcv {
+                // w_i |y_i − g_i|² = b² D_i |(Qu)_i|², exact even where g_i ≈ y_i.
+                rss += b * b * di * qu.length_squared();
+            }
+        }
+        for v in &mut u {
+            *v *= a;
+        }
+        Ok(Fit {
+            p: a,
+            alpha,
+            values,
+            second: u,
+            rss,
+            trace_residual,
+        })
+    }
+
+    /// `(Q v)_i` for `v` given at every knot (zero at the open ends).
+    #[inline]
+    fn q_row_times(&self, v: &[Vec2], i: usize) -> Vec2 {
+        let n = self.n();
+        if self.closed {
+            let (im, ip) = (self.prev(i), self.next(i));
+            (v[im] - v[i]) * self.ih[im] + (v[ip] - v[i]) * self.ih[i]
+        } else if i == 0 {
+            (v[1] - v[0]) * self.ih[0]
+        } else if i == n - 1 {
+            (v[i - 1] - v[i]) * self.ih[i - 1]
+        } else {
+            (v[i - 1] - v[i]) * self.ih[i - 1] + (v[i + 1] - v[i]) * self.ih[i]
+        }
+    }
+
+    /// `Σ_i W⁻¹_ii q_iᵀ M⁻¹ q_i` with `M⁻¹` read by knot indices through `inv` (only pairs of
+    /// unknown knots at cyclic distance ≤ 2 are asked for).
+    fn trace_term(&self, inv: impl Fn(usize, usize) -> f64) -> f64 {
+        let n = self.n();
+        let is_unknown = |k: usize| self.closed || (1..n - 1).contains(&k);
+        let mut total = 0.0;
+        for i in 0..n {
+            let di = self.d(i);
+            if di == 0.0 {
+                continue;
+            }
+            // Row i of Q: knots i−1, i, i+1 with 1/h_{i−1}, −(1/h_{i−1} + 1/h_i), 1/h_i.
+            let mut q = [(0usize, 0.0f64); 3];
+            let mut len = 0;
+            if self.closed || i > 0 {
+                let im = self.prev(i);
+                if is_unknown(im) {
+                    q[len] = (im, self.ih[im]);
+                    len += 1;
+                }
+            }
+            if is_unknown(i) {
+                q[len] = (i, -(self.ih[self.prev(i)] + self.ih[i]));
+                len += 1;
+            }
+            if self.closed || i + 1 < n {
+                let ip = self.next(i);
+                if is_unknown(ip) {
+                    q[len] = (ip, self.ih[i]);
+                    len += 1;
+                }
+            }
+            let mut quad = 0.0;
+            for &(ka, va) in &q[..len] {
+                for &(kb, vb) in &q[..len] {
+                    quad += va * vb * inv(ka, kb);
+                }
+            }
+            total += di * quad;
+        }
+        total
+    }
+
+    /// p = 0 on an open curve: the weighted least-squares line in t, constrained through the
+    /// pinned points (at most two).
+    fn fit_line(&self) -> Result<Fit> {
+        let n = self.n();
+        let pins: Vec<usize> = (0..n).filter(|&i| self.d(i) == 0.0).collect();
+        let t = self.t;
+        // The line is `origin + slope · (t − t_origin)`.
+        let (t_origin, origin, slope) = match pins.as_slice() {
+            [] => {
+                let (mut sw, mut st, mut sy) = (0.0, 0.0, Vec2::ZERO);
+                for (i, (&ti, yi)) in t.iter().zip(self.y).enumerate() {
+                    let w = 1.0 / self.d(i);
+                    sw += w;
+                    st += w * ti;
+                    sy += yi.to_vec2() * w;
+                }
+                let (tm, ym) = (st / sw, sy / sw);
+                (tm, ym, self.slope_about(tm, ym, None))
+            }
+            &[k] => {
+                let (tk, yk) = (t[k], self.y[k].to_vec2());
+                (tk, yk, self.slope_about(tk, yk, Some(k)))
+            }
+            &[k0, k1] => {
+                let (t0, y0) = (t[k0], self.y[k0].to_vec2());
+                (t0, y0, (self.y[k1].to_vec2() - y0) / (t[k1] - t0))
+            }
+            _ => {
+                return Err(Error::InvalidParameter {
+                    name: "p".into(),
+                    reason: "p = 0 with more than two pinned points (infinite weights) is not \
+                             a line; use p > 0"
+                        .into(),
+                });
+            }
+        };
+        let mut values = Vec::with_capacity(n);
+        for (i, (&ti, &yi)) in t.iter().zip(self.y).enumerate() {
+            let g = if self.d(i) == 0.0 {
+                yi
+            } else {
+                (origin + slope * (ti - t_origin)).to_point()
+            };
+            values.push(g);
+        }
+        if values.iter().any(|g| !g.is_finite()) {
+            return Err(Error::Singular("least-squares line is not finite".into()));
+        }
+        Ok(Fit {
+            p: 0.0,
+            alpha: f64::INFINITY,
+            values,
+            second: vec![Vec2::ZERO; n],
+            rss: 0.0,
+            trace_residual: 0.0,
+        })
+    }
+
+    /// The weighted least-squares slope of the points about the fixed `(t0, y0)`, leaving out
+    /// point `skip`.
+    fn slope_about(&self, t0: f64, y0: Vec2, skip: Option<usize>) -> Vec2 {
+        let (mut stt, mut sty) = (0.0, Vec2::ZERO);
+        for i in (0..self.n()).filter(|&i| Some(i) != skip) {
+            let w = 1.0 / self.d(i);
+            let dt = self.t[i] - t0;
+            stt += w * dt * dt;
+            sty += (self.y[i].to_vec2() - y0) * (w * dt);
+        }
+        sty / stt
+    }
+
+    fn into_spline(self, fit: Fit) -> SmoothingSpline {
+        SmoothingSpline {
+            t: self.t.to_vec(),
+            values: fit.values,
+            second: fit.second,
+            p: fit.p,
+            alpha: fit.alpha,
+            closed: self.closed,
+        }
+    }
+
+    fn trial(&self, fit: &Fit, gcv: Option<f64>) -> SmoothingTrial {
+        SmoothingTrial {
+            p: fit.p,
+            alpha: fit.alpha,
+            max_displacement: max_displacement(self.y, &fit.values),
+            roughness: roughness(self.t, &fit.second, self.closed),
+            gcv,
+        }
+    }
+
+    /// The `ln(α/α_ref)` search interval.
+    fn log_alpha_range(&self) -> (f64, f64) {
+        (
+            -LOG_ALPHA_BELOW,
+            4.0 * (self.n() as f64).ln() + LOG_ALPHA_ABOVE,
+        )
+    }
+
+    /// The result of tolerance mode.
+    fn finish(
+        self,
+        fit: Fit,
+        trials: Vec<SmoothingTrial>,
+        converged: bool,
+        notes: Vec<String>,
+    ) -> Result<(SmoothingSpline, SmoothingInfo)> {
+        let info = SmoothingInfo {
+            p: fit.p,
+            alpha: fit.alpha,
+            gcv: None,
+            degrees_of_freedom: None,
+            trials,
+            converged,
+            notes,
+        };
+        Ok((self.into_spline(fit), info))
+    }
+
+    /// Tolerance mode: bisection on `ln α` for the largest feasible α.
+    fn search_tolerance(
+        self,
+        tolerance: f64,
+        max_steps: usize,
+    ) -> Result<(SmoothingSpline, SmoothingInfo)> {
+        let mut trials = Vec::new();
+        let mut notes = Vec::new();
+        // The smoothest candidate of an open curve: the least-squares line.
+        if !self.closed {
+            match self.fit_line() {
+                Ok(line) => {
+                    trials.push(self.trial(&line, None));
+                    if max_displacement(self.y, &line.values) <= tolerance {
+                        notes.push("the least-squares line is within the tolerance".into());
+                        return self.finish(line, trials, true, notes);
+                    }
+                }
+                Err(e @ Error::Singular(_)) => return Err(e),
+                Err(_) => {} // more than two pins: no line candidate
+            }
+        }
+        let interpolant = |problem: &Problem<'_>| problem.solve(1.0, 0.0, 0.0, false);
+        if self.m() == 0 {
+            let fit = interpolant(&self)?;
+            return self.finish(fit, trials, true, notes);
+        }
+        let alpha_ref = self.alpha_ref()?;
+        let (mut lo, mut hi) = self.log_alpha_range();
+        let y = self.y;
+        let feasible = |fit: &Result<Fit>| {
+            fit.as_ref()
+                .is_ok_and(|f| max_displacement(y, &f.values) <= tolerance)
+        };
+        let top = self.fit_log_alpha(alpha_ref, hi, false);
+        if let Ok(f) = &top {
+            trials.push(self.trial(f, None));
+        }
+        if feasible(&top) {
+            notes.push("the smoothest spline searched is within the tolerance".into());
+            let fit = top?;
+            return self.finish(fit, trials, true, notes);
+        }
+        let mut best = match self.fit_log_alpha(alpha_ref, lo, false) {
+            Ok(f) if max_displacement(self.y, &f.values) <= tolerance => {
+                trials.push(self.trial(&f, None));
+                f
+            }
+            other => {
+                if let Ok(f) = &other {
+                    trials.push(self.trial(f, None));
+                }
+                notes.push(
+                    "the tolerance is below what any smoothing allows; the result interpolates"
+                        .into(),
+                );
+                let fit = interpolant(&self)?;
+                return self.finish(fit, trials, true, notes);
+            }
+        };
+        let precision = BISECTION_REL_PRECISION.ln_1p();
+        let mut steps = 0;
+        while hi - lo > precision && steps < max_steps {
+            let mid = 0.5 * (lo + hi);
+            let fit = self.fit_log_alpha(alpha_ref, mid, false);
+            if let Ok(f) = &fit {
+                trials.push(self.trial(f, None));
+            }
+            if feasible(&fit) {
+                lo = mid;
+                best = fit?;
+            } else {
+                hi = mid;
+            }
+            steps += 1;
+        }
+        let converged = hi - lo <= precision;
+        if !converged {
+            notes.push(format!(
+                "bisection stopped after {steps} steps with α known to a factor {:.3e}",
+                (hi - lo).exp()
+            ));
+        }
+        self.finish(best, trials, converged, notes)
+    }
+
+    /// GCV mode: coarse scan of `ln α`, then Brent around the best scan point.
+    fn search_gcv(self) -> Result<(SmoothingSpline, SmoothingInfo)> {
+        if self.n() < 3 {
+            return Err(Error::TooFewPoints {
+                needed: 3,
+                got: self.n(),
+            });
+        }
+        let alpha_ref = self.alpha_ref()?;
+        let n = self.n() as f64;
+        let mut trials = Vec::new();
+        let score = |s: f64, trials: &mut Vec<SmoothingTrial>| -> f64 {
+            match self.fit_log_alpha(alpha_ref, s, true) {
+                Ok(f) => {
+                    let v = n * f.rss / (f.trace_residual * f.trace_residual);
+                    let v = if v.is_finite() { v } else { f64::INFINITY };
+                    trials.push(self.trial(&f, Some(v)));
+                    v
+                }
+                Err(_) => f64::INFINITY,
+            }
+        };
+        let (lo, hi) = self.log_alpha_range();
+        let steps = ((hi - lo) / GCV_SCAN_STEP).ceil() as usize;
+        let mut best = (f64::NAN, f64::INFINITY);
+        for k in 0..=steps {
+            let s = (lo + k as f64 * GCV_SCAN_STEP).min(hi);
+            let v = score(s, &mut trials);
+            if v < best.1 {
+                best = (s, v);
+            }
+        }
+        if !best.1.is_finite() {
+            return Err(Error::NoConvergence(
+                "generalised cross-validation: no trial spline could be solved".into(),
+            ));
+        }
+        let (a, b) = (
+            (best.0 - GCV_SCAN_STEP).max(lo),
+            (best.0 + GCV_SCAN_STEP).min(hi),
+        );
+        let m = minimize_brent(
+            |s| score(s, &mut trials),
+            a,
+            b,
+            0.0,
+            GCV_LOG_ALPHA_TOL,
+            GCV_MAX_EVALUATIONS,
+        );
+        let converged = m.evaluations < GCV_MAX_EVALUATIONS;
+        let s = if m.fx < best.1 { m.x } else { best.0 };
+        let fit = self.fit_log_alpha(alpha_ref, s, true)?;
+        let gcv = n * fit.rss / (fit.trace_residual * fit.trace_residual);
+        let mut notes = Vec::new();
+        if s <= lo || s >= hi {
+            notes.push(format!(
+                "the GCV minimum is at the end of the searched range (ln(α/α_ref) = {s:.1})"
+            ));
+        }
+        let info = SmoothingInfo {
+            p: fit.p,
+            alpha: fit.alpha,
+            gcv: Some(gcv),
+            degrees_of_freedom: Some(n - fit.trace_residual),
+            trials,
+            converged,
+            notes,
+        };
+        Ok((self.into_spline(fit), info))
+    }
+}
+
+/// The parameter list of [`Mst`].
+static PARAMS: &[ParamSpec] = &[ParamSpec {
+    name: "p",
+    default: "auto",
+    doc: "smoothing parameter in [0, 1] (1 interpolates, 0 is the least-squares line); \
+          auto: the smoothest within --tolerance, else generalised cross-validation",
+}];
+
+/// The `mst` fairing method: the cubic smoothing spline of the points at chord-length
+/// parameters, with p given (`--set p=…`), chosen for `--tolerance`, or by GCV. See the module
+/// documentation for the equations and [`SmoothingSpline`] for the library API.
+///
+/// Reports `p`, `alpha`, `selection` (`given`, `tolerance`, `gcv`) and, for GCV, `gcv` and
+/// `degrees_of_freedom` in [`Outcome::parameters`]; iterations are bisection steps or GCV
+/// evaluations.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Mst;
+
+impl FairMethod for Mst {
+    fn name(&self) -> &'static str {
+        "mst"
+    }
+
+    fn description(&self) -> &'static str {
+        "cubic smoothing spline (Reinsch / de Boor SMOOTH, Matlab csaps; Han et al.'s MST): \
+         p given, else the smoothest within the tolerance, else GCV"
+    }
+
+    fn parameters(&self) -> &'static [ParamSpec] {
+        PARAMS
+    }
+
+    fn supports_closed(&self) -> bool {
+        true
+    }
+
+    fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
+        let points = input.points();
+        let closed = input.is_closed();
+        let n = points.len();
+        let t = parameters(points, Parametrization::ChordLength, closed)?;
+        let p = match options.params.get("p").map(|s| s.trim()) {
+            None | Some("auto") => None,
+            Some(_) => {
+                let p = options.param_f64_in("p", 1.0, 0.0, 1.0)?;
+                check_p(p, closed)?;
+                Some(p)
+            }
+        };
+        let mut notes = Vec::new();
+        let weights: Option<Vec<f64>> = if options.fix_ends && !closed {
+            let mut w = vec![1.0; n];
+            w[0] = f64::INFINITY;
+            w[n - 1] = f64::INFINITY;
+            Some(w)
+        } else {
+            if options.fix_ends {
+                notes.push("fix_ends has no effect on a closed curve".to_string());
+            }
+            None
+        };
+        let (how, selection) = match (p, options.tolerance) {
+            (Some(p), tol) => {
+                if tol.is_some() {
+                    notes.push("p was given, so the tolerance does not choose it".to_string());
+                }
+                (Smoothing::P(p), "given")
+            }
+            (None, Some(tolerance)) => (
+                Smoothing::MaxDisplacement {
+                    tolerance,
+                    max_steps: options.iterations_or(DEFAULT_MAX_BISECTION_STEPS),
+                },
+                "tolerance",
+            ),
+            (None, None) => (Smoothing::Gcv, "gcv"),
+        };
+        let (spline, info) = SmoothingSpline::select(&t, points, weights.as_deref(), closed, how)?;
+        let mut parameters = Map::new();
+        parameters.insert("p".into(), json_f64(info.p));
+        parameters.insert("alpha".into(), json_f64(info.alpha));
+        parameters.insert("selection".into(), Value::from(selection));
+        if let Some(g) = info.gcv {
+            parameters.insert("gcv".into(), json_f64(g));
+        }
+        if let Some(d) = info.degrees_of_freedom {
+            parameters.insert("degrees_of_freedom".into(), json_f64(d));
+        }
+        parameters.insert("roughness".into(), json_f64(spline.roughness()));
+        let mut history = Vec::new();
+        if matches!(how, Smoothing::MaxDisplacement { .. }) {
+            history = info
+                .trials
+                .iter()
+                .enumerate()
+                .map(|(k, tr)| HistoryRow {
+                    iteration: k + 1,
+                    measure: tr.roughness,
+                    max_distance: tr.max_displacement,
+                })
+                .collect();
+        }
+        let status = if info.converged {
+            FairStatus::Converged
+        } else {
+            FairStatus::IterationLimit
+        };
+        notes.extend(info.notes);
+        Ok(Outcome {
+            iterations: info.trials.len(),
+            points: spline.into_values(),
+            status,
+            parameters,
+            history,
+            notes,
+            ..Outcome::default()
+        })
+    }
+}
+
+/// A JSON number, or `null` for a non-finite value (JSON has no infinity).
+fn json_f64(v: f64) -> Value {
+    serde_json::Number::from_f64(v).map_or(Value::Null, Value::Number)
+}
