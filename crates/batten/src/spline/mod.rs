@@ -12,10 +12,12 @@ mod bspline_ops;
 mod function;
 mod interpolate;
 mod knots;
+mod lambda_operator;
 mod parametric;
 
 pub use bspline::{BSplineCurve, MAX_ORDER};
 pub use bspline_ops::{DEVIATION_SAMPLES_PER_SPAN, KnotRef, KnotRemoval, RemovalRule};
 pub use function::{CubicSplineFn, FnEndCondition};
 pub use knots::KnotVector;
+pub use lambda_operator::{LOCAL_HALF_WIDTH, LOCAL_WIDTH, LambdaOperator};
 pub use parametric::{EndCondition, ParametricCubic, Parametrization, parameters};
