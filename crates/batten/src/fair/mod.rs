@@ -10,12 +10,14 @@
 //! Adding a method: implement [`FairMethod`] in a file of its own under `fair/` and list it
 //! in [`methods`].
 
+pub mod cali;
 mod options;
 mod report;
 mod smoothing;
 
 use std::time::Instant;
 
+pub use cali::Cali;
 pub use options::{FairOptions, ParamSpec};
 pub use report::{FairReport, FairStatus, HistoryRow, Move};
 pub use smoothing::{Mst, Smoothing, SmoothingInfo, SmoothingSpline, SmoothingTrial};
@@ -79,8 +81,9 @@ pub struct Faired {
 }
 
 static MST: Mst = Mst;
+static CALI: Cali = Cali;
 
-static REGISTRY: &[&dyn FairMethod] = &[&MST];
+static REGISTRY: &[&dyn FairMethod] = &[&MST, &CALI];
 
 /// Every registered method, the default first.
 pub fn methods() -> &'static [&'static dyn FairMethod] {
