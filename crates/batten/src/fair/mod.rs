@@ -13,7 +13,7 @@
 pub mod cali;
 mod options;
 mod report;
-mod smoothing;
+pub mod smoothing;
 
 use std::time::Instant;
 

@@ -79,8 +79,9 @@ pub const BISECTION_REL_PRECISION: f64 = 1e-3;
 /// [`BISECTION_REL_PRECISION`]; the default leaves ample room.
 pub const DEFAULT_MAX_BISECTION_STEPS: usize = 60;
 
-/// The searches start `LOG_ALPHA_BELOW` units of `ln α` below `ln α_ref`: at `α = α_ref·e⁻²⁵`
-/// the spline interpolates to about 10⁻¹¹ of the data's roughness.
+/// The searches start `LOG_ALPHA_BELOW` units of `ln α` below `ln α_ref`. The displacements
+/// `g − y = α W⁻¹ Q γ` vanish linearly with α, so at `α = α_ref·e⁻²⁵ ≈ 1.4·10⁻¹¹ α_ref` they
+/// are that fraction of those at `α_ref`: interpolation, to plotting accuracy.
 const LOG_ALPHA_BELOW: f64 = 25.0;
 
 /// The searches end `4 ln n + LOG_ALPHA_ABOVE` units of `ln α` above `ln α_ref`: the smoothing
@@ -990,9 +991,12 @@ static PARAMS: &[ParamSpec] = &[ParamSpec {
 /// parameters, with p given (`--set p=…`), chosen for `--tolerance`, or by GCV. See the module
 /// documentation for the equations and [`SmoothingSpline`] for the library API.
 ///
-/// Reports `p`, `alpha`, `selection` (`given`, `tolerance`, `gcv`) and, for GCV, `gcv` and
-/// `degrees_of_freedom` in [`Outcome::parameters`]; iterations are bisection steps or GCV
-/// evaluations.
+/// Reports `p`, `alpha`, `selection` (`given`, `tolerance`, `gcv`), `roughness` and, for GCV,
+/// `gcv` and `degrees_of_freedom` in [`Outcome::parameters`]; iterations are the splines the
+/// search computed (bisection steps or GCV evaluations). [`Outcome::curve`] is left empty: the
+/// method's product is the points, and building the curve would triple its cost at 10⁶
+/// points; the library's [`SmoothingSpline::curve`] gives the spline itself
+/// (`BSplineCurve::from_parametric_cubic` turns it into exact B-spline form).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Mst;
 

@@ -23,7 +23,7 @@ use crate::error::Result;
 /// `a` must not have been factorised before.
 ///
 /// # Errors
-/// [`Error::Singular`] from the factorisation.
+/// [`Error::Singular`](crate::Error::Singular) from the factorisation.
 pub fn factorize_with_inverse_band(a: &mut SymBanded) -> Result<SymBanded> {
     a.factorize()?;
     let (n, bw) = (a.n(), a.bandwidth());
