@@ -161,10 +161,9 @@ fn agrees_with_csaps() {
 // ------------------------------------------------------------------------------------------
 // An independent dense solve of the same objective.
 
-/// Dense reference: `g = argmin p Σ w|y − g|² + (1 − p) gᵀ K g` with `K = Q R⁻¹ Qᵀ`, the
-/// bending energy of the natural (open) or periodic (closed) interpolating spline through g.
-fn dense_reference(t: &[f64], pts: &[Point], w: &[f64], p: f64, closed: bool) -> Vec<Point> {
-    let n = pts.len();
+/// `K = Q R⁻¹ Qᵀ`: `gᵀ K g` is the bending energy `∫|C''|²` of the natural (open) or
+/// periodic (closed) interpolating spline through g at parameters t.
+fn dense_energy_matrix(t: &[f64], n: usize, closed: bool) -> DMatrix<f64> {
     let (m, off) = if closed { (n, 0) } else { (n - 2, 1) };
     let h: Vec<f64> = t.windows(2).map(|v| v[1] - v[0]).collect();
     let mut q = DMatrix::<f64>::zeros(n, m);
@@ -183,12 +182,23 @@ fn dense_reference(t: &[f64], pts: &[Point], w: &[f64], p: f64, closed: bool) ->
             r[(jn, j)] += h[k] / 6.0;
         }
     }
-    let k_mat = &q * r.try_inverse().unwrap() * q.transpose();
-    let mut a = k_mat * (1.0 - p);
+    &q * r.try_inverse().unwrap() * q.transpose()
+}
+
+/// `(p W + (1 − p) K)`, the matrix of the dense reference solve.
+fn dense_system(t: &[f64], w: &[f64], p: f64, closed: bool) -> DMatrix<f64> {
+    let n = w.len();
+    let mut a = dense_energy_matrix(t, n, closed) * (1.0 - p);
     for i in 0..n {
         a[(i, i)] += p * w[i];
     }
-    let lu = a.lu();
+    a
+}
+
+/// Dense reference: `g = argmin p Σ w|y − g|² + (1 − p) gᵀ K g`.
+fn dense_reference(t: &[f64], pts: &[Point], w: &[f64], p: f64, closed: bool) -> Vec<Point> {
+    let n = pts.len();
+    let lu = dense_system(t, w, p, closed).lu();
     let bx = DVector::from_iterator(n, (0..n).map(|i| p * w[i] * pts[i].x));
     let by = DVector::from_iterator(n, (0..n).map(|i| p * w[i] * pts[i].y));
     let gx = lu.solve(&bx).unwrap();
@@ -215,6 +225,51 @@ fn matches_dense_reference_open_and_closed() {
             let err = max_dist(fit.values(), &reference);
             assert!(err <= 1e-10 * scale, "closed={is_closed} p={p}: {err:e}");
         }
+    }
+}
+
+#[test]
+fn gcv_degrees_of_freedom_match_the_dense_influence_trace() {
+    // tr A with A = (pW + (1 − p)K)⁻¹ pW, against the O(n) band-of-the-inverse computation.
+    let (_, open) = noisy_open(17, 60, 0.02);
+    let closed = noisy_closed(18, 50, 0.02);
+    let mut rng = Rng::new(19);
+    for (pts, is_closed) in [(open, false), (closed, true)] {
+        let t = chord(&pts, is_closed);
+        let n = pts.len();
+        let w: Vec<f64> = (0..n).map(|_| 0.5 + rng.uniform()).collect();
+        let (fit, info) =
+            SmoothingSpline::select(&t, &pts, Some(&w), is_closed, Smoothing::Gcv).unwrap();
+        let dof = info.degrees_of_freedom.unwrap();
+        let p = fit.p();
+        let mut pw = DMatrix::<f64>::zeros(n, n);
+        for i in 0..n {
+            pw[(i, i)] = p * w[i];
+        }
+        let a = dense_system(&t, &w, p, is_closed).lu().solve(&pw).unwrap();
+        let dense_dof = a.trace();
+        assert!(
+            (dof - dense_dof).abs() <= 1e-8 * n as f64,
+            "closed={is_closed}: {dof} vs {dense_dof}"
+        );
+        assert!(dof > 2.0 && dof < n as f64 - 1.0);
+        // The reported GCV score is n·RSS/tr(I − A)² at the chosen spline.
+        let rss: f64 = fit
+            .values()
+            .iter()
+            .zip(&pts)
+            .zip(&w)
+            .map(|((g, y), wi)| wi * (*g - *y).length_squared())
+            .sum();
+        let gcv = n as f64 * rss / (n as f64 - dense_dof).powi(2);
+        assert!((info.gcv.unwrap() / gcv - 1.0).abs() < 1e-8);
+        // And it is a minimum along the search's trace.
+        let best = info
+            .trials
+            .iter()
+            .filter_map(|tr| tr.gcv)
+            .fold(f64::INFINITY, f64::min);
+        assert!(info.gcv.unwrap() <= best * (1.0 + 1e-12));
     }
 }
 
