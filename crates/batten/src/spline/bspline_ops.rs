@@ -448,6 +448,14 @@ impl BSplineCurve {
     /// `degree` and are solved by [`SymBanded`] in O(m·p²). Returns the curve and the data
     /// parameters.
     ///
+    /// Eq 9.69 assumes fewer control points than points: with as many, the least-squares
+    /// curve is the interpolant, and [`BSplineCurve::interpolate`] (averaging knots) is
+    /// returned. Close to that count the eq 9.69 knots leave some basis functions with a single
+    /// data point near the tail of their support, and the normal equations become singular to
+    /// working precision ([`Error::Singular`]): with 400 chord-length points of a smooth curve,
+    /// from about 350 cubic control points on. Fit with clearly fewer control points than
+    /// points, or interpolate.
+    ///
     /// # Errors
     /// [`Error::InvalidParameter`] for a degree outside `1..MAX_ORDER` or `n_ctrl < degree + 1`;
     /// [`Error::TooFewPoints`] when there are fewer points than control points; the errors of
@@ -476,6 +484,9 @@ impl BSplineCurve {
                 needed: n_ctrl,
                 got: points.len(),
             });
+        }
+        if n_ctrl == points.len() {
+            return BSplineCurve::interpolate(points, degree, param);
         }
         let mut t = parameters(points, param, false)?;
         let m = points.len() - 1;
