@@ -11,6 +11,7 @@
 //! in [`methods`].
 
 pub mod cali;
+pub mod han;
 mod options;
 mod report;
 pub mod smoothing;
@@ -18,6 +19,7 @@ pub mod smoothing;
 use std::time::Instant;
 
 pub use cali::Cali;
+pub use han::Han;
 pub use options::{FairOptions, ParamSpec};
 pub use report::{FairReport, FairStatus, HistoryRow, Move};
 pub use smoothing::{Mst, Smoothing, SmoothingInfo, SmoothingSpline, SmoothingTrial};
@@ -82,8 +84,9 @@ pub struct Faired {
 
 static MST: Mst = Mst;
 static CALI: Cali = Cali;
+static HAN: Han = Han;
 
-static REGISTRY: &[&dyn FairMethod] = &[&MST, &CALI];
+static REGISTRY: &[&dyn FairMethod] = &[&MST, &HAN, &CALI];
 
 /// Every registered method, the default first.
 pub fn methods() -> &'static [&'static dyn FairMethod] {

@@ -295,8 +295,8 @@ impl CubicSplineFn {
     pub fn indicator(&self) -> Vec<f64> {
         let n = self.len();
         let mut e = vec![0.0; n];
-        for i in 1..n - 1 {
-            e[i] = (self.c[i + 1] - self.c[i]) / self.h[i]
+        for (i, ei) in e.iter_mut().enumerate().take(n - 1).skip(1) {
+            *ei = (self.c[i + 1] - self.c[i]) / self.h[i]
                 - (self.c[i] - self.c[i - 1]) / self.h[i - 1];
         }
         e
@@ -384,6 +384,7 @@ impl Piecewise for CubicSplineFn {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used, clippy::needless_range_loop)]
 mod tests {
     use super::*;
 
