@@ -1,1 +1,160 @@
-fn main() {}
+//! `batten`: analyse, fair and compare planar curves given as point files.
+//!
+//! Exit codes: 0 success; 1 a fairing that failed, or did not meet its tolerance (output and
+//! report are still written then), or an output that could not be written; 2 bad input or
+//! usage (unreadable or malformed input file, unknown method, unknown or malformed `--set`,
+//! bad option values), with exactly one line on stderr naming the file, the line and the
+//! problem. clap's own usage errors also exit 2.
+//!
+//! Output goes through explicit handles ([`output`]), never `println!`: a closed pipe
+//! (`batten methods | head -1`) must end the program quietly, where `println!` panics. So the
+//! crate needs no `allow` for the workspace's `print_stdout`/`print_stderr` lints.
+
+mod analyze;
+mod compare;
+mod failure;
+mod fair_cmd;
+mod input;
+mod methods;
+mod output;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+/// Fair planar curves: measure the curvature of the curve through a list of points, move the
+/// points as little as possible until it is fair, and compare the published methods.
+///
+/// Point files are chosen by extension: .csv/.txt (one "x,y" per line; comma, semicolon or
+/// whitespace separators; # comments; an optional header line) or .json
+/// ({"points": [[x, y], ...], "closed": false}).
+#[derive(Debug, Parser)]
+#[command(name = "batten", version, max_term_width = 100)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Print the fairness metrics of the curve through the points
+    Analyze(AnalyzeArgs),
+    /// Fair the points and write them (same count and order) to OUTPUT
+    Fair(FairArgs),
+    /// List the fairing methods, their descriptions and parameters
+    Methods,
+    /// Run several methods on the same input and tabulate the results (Han et al.'s Table 1)
+    Compare(CompareArgs),
+}
+
+/// Arguments of `batten analyze`.
+#[derive(Debug, Args)]
+struct AnalyzeArgs {
+    /// Point file (.csv, .txt or .json)
+    #[arg(value_name = "INPUT")]
+    input: PathBuf,
+    /// Print a JSON object instead of a table
+    #[arg(long)]
+    json: bool,
+    /// The points form a closed curve (the last connects to the first; do not repeat it)
+    #[arg(long)]
+    closed: bool,
+}
+
+/// Arguments of `batten fair`.
+#[derive(Debug, Args)]
+struct FairArgs {
+    /// Point file (.csv, .txt or .json)
+    #[arg(value_name = "INPUT")]
+    input: PathBuf,
+    /// Where to write the faired points; the format follows the extension (.csv, .txt, .json).
+    /// Never the input file
+    #[arg(short, long, value_name = "OUTPUT")]
+    output: PathBuf,
+    /// Fairing method (see `batten methods`) [default: the first listed there]
+    #[arg(long, value_name = "NAME")]
+    method: Option<String>,
+    /// Largest distance any point may move, in data units
+    #[arg(long, value_name = "D")]
+    tolerance: Option<f64>,
+    /// Keep the first and last points where they are
+    #[arg(long)]
+    fix_ends: bool,
+    /// Upper bound on the method's iterations (its own unit: sweeps, moves or passes)
+    #[arg(long, value_name = "N")]
+    max_iterations: Option<usize>,
+    /// Write the fairing report (JSON) to this file
+    #[arg(long, value_name = "R.json")]
+    report: Option<PathBuf>,
+    /// A method parameter, KEY=VALUE (repeat for several; see `batten methods`)
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// The points form a closed curve (a JSON file can say so with "closed": true)
+    #[arg(long)]
+    closed: bool,
+}
+
+/// Output format of `batten compare`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum TableFormat {
+    /// A Markdown table
+    Md,
+    /// A JSON object
+    Json,
+    /// CSV with a header row
+    Csv,
+}
+
+/// Arguments of `batten compare`.
+#[derive(Debug, Args)]
+struct CompareArgs {
+    /// Point file (.csv, .txt or .json)
+    #[arg(value_name = "INPUT")]
+    input: PathBuf,
+    /// Methods to run, comma-separated [default: all]. As in Han et al., mst runs at the max
+    /// displacement of the first method listed, unless it is first itself
+    #[arg(long, value_delimiter = ',', value_name = "A,B,...")]
+    methods: Vec<String>,
+    /// Largest distance any point may move, in data units
+    #[arg(long, value_name = "D")]
+    tolerance: Option<f64>,
+    /// Output format
+    #[arg(long, value_enum, default_value_t = TableFormat::Md)]
+    format: TableFormat,
+    /// Keep the first and last points where they are
+    #[arg(long)]
+    fix_ends: bool,
+    /// The points form a closed curve
+    #[arg(long)]
+    closed: bool,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Analyze(a) => analyze::run(&a),
+        Command::Fair(a) => fair_cmd::run(&a),
+        Command::Methods => methods::run(),
+        Command::Compare(a) => compare::run(&a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(f) => {
+            output::error_line(&f.error.to_string());
+            f.exit_code()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory as _;
+
+    use super::Cli;
+
+    #[test]
+    fn clap_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+}

@@ -1,0 +1,119 @@
+//! `batten analyze`: the fairness metrics of the curve through the points.
+
+use std::fmt::Write as _;
+use std::process::ExitCode;
+
+use anyhow::anyhow;
+use batten::FairnessMetrics;
+
+use crate::AnalyzeArgs;
+use crate::failure::Failure;
+use crate::input;
+use crate::output::{self, sig};
+
+/// Significant digits of real numbers in the table.
+const DIGITS: usize = 6;
+
+/// Run `batten analyze`.
+///
+/// # Errors
+/// Bad input (exit 2); a metric that cannot be computed (exit 1).
+pub fn run(args: &AnalyzeArgs) -> Result<ExitCode, Failure> {
+    let data = input::read(&args.input, args.closed)?;
+    let name = args.input.display().to_string();
+    let metrics = FairnessMetrics::of_seq(&data.seq)
+        .map_err(|e| Failure::from_batten(&format!("{name}: cannot analyse"), e))?;
+    let text = if args.json {
+        let mut s = serde_json::to_string_pretty(&metrics)
+            .map_err(|e| Failure::failed(anyhow!("cannot encode the metrics: {e}")))?;
+        s.push('\n');
+        s
+    } else {
+        table(&name, &metrics)
+    };
+    output::stdout(&text)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The human-readable table.
+fn table(name: &str, m: &FairnessMetrics) -> String {
+    let kind = if m.closed { "closed" } else { "open" };
+    let rows: [(&str, String, &str); 9] = [
+        (
+            "inflections",
+            m.inflections.to_string(),
+            "sign changes of κ",
+        ),
+        (
+            "vibrations",
+            m.vibrations.to_string(),
+            "sign changes of the dκ/ds jumps at the knots",
+        ),
+        (
+            "curvature extrema",
+            m.curvature_extrema.to_string(),
+            "local extrema of κ(s)",
+        ),
+        ("strain energy", sig(m.strain_energy, DIGITS), "∫ κ² ds"),
+        (
+            "variation energy",
+            sig(m.variation_energy, DIGITS),
+            "∫ (dκ/ds)² ds",
+        ),
+        ("max curvature", sig(m.max_curvature, DIGITS), "max |κ|"),
+        (
+            "GFI",
+            sig(m.gfi, DIGITS),
+            "Calì's global fairness indicator",
+        ),
+        (
+            "max r''' jump",
+            sig(m.max_third_derivative_jump, DIGITS),
+            "largest third-derivative jump at a knot",
+        ),
+        ("length", sig(m.length, DIGITS), "arc length"),
+    ];
+    let mut s = format!("{name}: {} points, {kind} curve\n", m.points);
+    for (label, value, what) in &rows {
+        // Writing to a String cannot fail.
+        let _ = writeln!(s, "  {label:<18} {value:>14}   {what}");
+    }
+    s
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use batten::{Point, PointSeq};
+
+    use super::*;
+
+    #[test]
+    fn table_lists_every_metric() {
+        let pts = (0..12)
+            .map(|i| {
+                let x = f64::from(i) * 0.5;
+                Point::new(x, x.sin())
+            })
+            .collect();
+        let m = FairnessMetrics::of_seq(&PointSeq::open(pts).unwrap()).unwrap();
+        let t = table("a.csv", &m);
+        assert!(t.starts_with("a.csv: 12 points, open curve\n"), "{t}");
+        for needle in [
+            "inflections",
+            "vibrations",
+            "curvature extrema",
+            "strain energy",
+            "variation energy",
+            "max curvature",
+            "GFI",
+            "max r''' jump",
+            "length",
+            &sig(m.strain_energy, DIGITS),
+            &sig(m.length, DIGITS),
+        ] {
+            assert!(t.contains(needle), "{needle} missing from\n{t}");
+        }
+        assert_eq!(t.lines().count(), 10);
+    }
+}

@@ -1,0 +1,383 @@
+//! `batten compare`: several methods on one input, tabulated like Table 1 of Han et al.
+//! (`Infl_num`, `Vib_num`, `S_d/M_d`, `E_s`), with Calì's GFI and the run time added.
+//!
+//! As in the paper, the smoothing spline `mst` is run at the same largest displacement as the
+//! first method listed: with `tolerance` = that method's `M_d` and no `p`, which makes `mst`
+//! bisect on `p`. When `mst` is listed first it runs with the options given.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::process::ExitCode;
+
+use anyhow::anyhow;
+use batten::fair::{self, FairMethod, FairReport};
+use batten::io::format_f64;
+use batten::{FairOptions, FairnessMetrics, PointSeq};
+use rayon::prelude::*;
+use serde_json::{Value, json};
+
+use crate::failure::{EXIT_FAILED, Failure};
+use crate::input;
+use crate::output::{self, seconds, sig};
+use crate::{CompareArgs, TableFormat};
+
+/// The method that is run at the displacement of the first one.
+const MST: &str = "mst";
+
+/// Significant digits of real numbers in the Markdown table.
+const DIGITS: usize = 4;
+
+/// How one method's run ended.
+#[derive(Debug)]
+enum Outcome {
+    Ran(Box<FairReport>),
+    Failed(String),
+    /// Not run, and why (e.g. a closed curve for a method that takes only open ones).
+    Skipped(String),
+}
+
+/// One row of the table.
+#[derive(Debug)]
+struct Row {
+    method: &'static str,
+    /// The tolerance the method ran with.
+    tolerance: Option<f64>,
+    /// Why the options differ from the ones given, if they do.
+    note: Option<String>,
+    outcome: Outcome,
+}
+
+/// Run `batten compare`.
+///
+/// # Errors
+/// Usage errors (exit 2); analysing the input failed (exit 1). Methods that fail are rows
+/// of the table, and make the exit code 1 after it is printed.
+pub fn run(args: &CompareArgs) -> Result<ExitCode, Failure> {
+    let methods = resolve(&args.methods)?;
+    let base = input::options(args.tolerance, args.fix_ends, None, BTreeMap::new());
+    base.validate().map_err(|e| Failure::from_batten("", e))?;
+    let data = input::read(&args.input, args.closed)?;
+    let name = args.input.display().to_string();
+    let before = FairnessMetrics::of_seq(&data.seq)
+        .map_err(|e| Failure::from_batten(&format!("{name}: cannot analyse"), e))?;
+
+    let rows = run_methods(&methods, &data.seq, &base);
+    let text = match args.format {
+        TableFormat::Md => markdown(&name, &data.seq, &base, &before, &rows),
+        TableFormat::Csv => csv(&before, &rows),
+        TableFormat::Json => {
+            let mut s = serde_json::to_string_pretty(&to_json(&name, &base, &before, &rows))
+                .map_err(|e| Failure::failed(anyhow!("cannot encode the table: {e}")))?;
+            s.push('\n');
+            s
+        }
+    };
+    output::stdout(&text)?;
+    let mut failed = false;
+    for row in &rows {
+        if let Outcome::Failed(msg) = &row.outcome {
+            output::error_line(&format!("{name}: method {} failed: {msg}", row.method));
+            failed = true;
+        }
+    }
+    Ok(if failed {
+        ExitCode::from(EXIT_FAILED)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// The methods named (all registered when none), each once.
+fn resolve(names: &[String]) -> Result<Vec<&'static dyn FairMethod>, Failure> {
+    if names.is_empty() {
+        return Ok(fair::methods().to_vec());
+    }
+    let mut out: Vec<&'static dyn FairMethod> = Vec::with_capacity(names.len());
+    for n in names {
+        let m = input::method(n.trim())?;
+        if out.iter().any(|o| o.name() == m.name()) {
+            return Err(Failure::usage(anyhow!(
+                "--methods lists {} more than once",
+                m.name()
+            )));
+        }
+        out.push(m);
+    }
+    Ok(out)
+}
+
+/// Run every method (in parallel), `mst` at the first method's displacement.
+fn run_methods(
+    methods: &[&'static dyn FairMethod],
+    seq: &PointSeq,
+    base: &FairOptions,
+) -> Vec<Row> {
+    let Some((&first, rest)) = methods.split_first() else {
+        return Vec::new();
+    };
+    if first.name() == MST || !rest.iter().any(|m| m.name() == MST) {
+        return methods
+            .par_iter()
+            .map(|&m| run_one(m, seq, base.clone(), None))
+            .collect();
+    }
+    let first_row = run_one(first, seq, base.clone(), None);
+    let (mst_options, mst_note) = match &first_row.outcome {
+        Outcome::Ran(r) if r.max_displacement > 0.0 => {
+            let mut o = base.clone();
+            o.tolerance = Some(r.max_displacement);
+            o.params.clear();
+            let note = format!(
+                "run at tolerance {}, the max displacement of {} (as in Han et al.)",
+                sig(r.max_displacement, DIGITS),
+                first.name()
+            );
+            (o, note)
+        }
+        Outcome::Ran(_) => (
+            base.clone(),
+            format!(
+                "{} moved no point, so {MST} ran with the options given",
+                first.name()
+            ),
+        ),
+        _ => (
+            base.clone(),
+            format!(
+                "{} did not run, so {MST} ran with the options given",
+                first.name()
+            ),
+        ),
+    };
+    let mut rows = vec![first_row];
+    rows.par_extend(rest.par_iter().map(|&m| {
+        if m.name() == MST {
+            run_one(m, seq, mst_options.clone(), Some(mst_note.clone()))
+        } else {
+            run_one(m, seq, base.clone(), None)
+        }
+    }));
+    rows
+}
+
+fn run_one(
+    m: &'static dyn FairMethod,
+    seq: &PointSeq,
+    options: FairOptions,
+    note: Option<String>,
+) -> Row {
+    let outcome = if seq.is_closed() && !m.supports_closed() {
+        Outcome::Skipped("does not support closed curves".to_string())
+    } else {
+        match fair::fair_with(m, seq, &options) {
+            Ok(f) => Outcome::Ran(Box::new(f.report)),
+            Err(e) => Outcome::Failed(e.to_string()),
+        }
+    };
+    Row {
+        method: m.name(),
+        tolerance: options.tolerance,
+        note,
+        outcome,
+    }
+}
+
+/// Remarks under the Markdown table: why options differ, failures, missed tolerances.
+fn remarks(row: &Row) -> Vec<String> {
+    let mut v: Vec<String> = row.note.iter().cloned().collect();
+    match &row.outcome {
+        Outcome::Ran(r) if !r.tolerance_met => v.push(format!(
+            "tolerance {} not met",
+            r.tolerance.map_or_else(String::new, format_f64)
+        )),
+        Outcome::Ran(_) => {}
+        Outcome::Failed(msg) => v.push(format!("failed: {msg}")),
+        Outcome::Skipped(why) => v.push(format!("skipped: {why}")),
+    }
+    v
+}
+
+fn markdown(
+    name: &str,
+    seq: &PointSeq,
+    base: &FairOptions,
+    before: &FairnessMetrics,
+    rows: &[Row],
+) -> String {
+    let mut s = format!(
+        "{name}: {} points, {}; tolerance {}{}\n\n",
+        seq.len(),
+        if seq.is_closed() { "closed" } else { "open" },
+        base.tolerance
+            .map_or_else(|| "none".to_string(), format_f64),
+        if base.fix_ends { ", ends fixed" } else { "" },
+    );
+    s.push_str("| Method | Infl | Vib | S_d/M_d | E_s | GFI | time |\n");
+    s.push_str("| :-- | --: | --: | --: | --: | --: | --: |\n");
+    // Writing to a String cannot fail.
+    let _ = writeln!(
+        s,
+        "| input | {} | {} | – | {} | {} | – |",
+        before.inflections,
+        before.vibrations,
+        sig(before.strain_energy, DIGITS),
+        sig(before.gfi, DIGITS)
+    );
+    let mut notes = Vec::new();
+    for row in rows {
+        let r = remarks(row);
+        let mark = if r.is_empty() {
+            String::new()
+        } else {
+            notes.push((row.method, r));
+            format!(" [{}]", notes.len())
+        };
+        let _ = match &row.outcome {
+            Outcome::Ran(rep) => writeln!(
+                s,
+                "| {}{mark} | {} | {} | {}/{} | {} | {} | {} |",
+                row.method,
+                rep.after.inflections,
+                rep.after.vibrations,
+                sig(rep.sum_displacement, DIGITS),
+                sig(rep.max_displacement, DIGITS),
+                sig(rep.after.strain_energy, DIGITS),
+                sig(rep.after.gfi, DIGITS),
+                seconds(rep.elapsed_seconds),
+            ),
+            Outcome::Failed(_) => writeln!(s, "| {}{mark} | failed | | | | | |", row.method),
+            Outcome::Skipped(_) => writeln!(s, "| {}{mark} | skipped | | | | | |", row.method),
+        };
+    }
+    if !notes.is_empty() {
+        s.push('\n');
+        for (i, (method, r)) in notes.iter().enumerate() {
+            let _ = writeln!(s, "[{}] {method}: {}", i + 1, r.join("; "));
+        }
+    }
+    s
+}
+
+/// A CSV field, quoted when it must be.
+fn csv_field(text: &str) -> String {
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
+}
+
+/// A number for CSV: exact, or empty when not finite.
+fn csv_num(x: f64) -> String {
+    if x.is_finite() {
+        format_f64(x)
+    } else {
+        String::new()
+    }
+}
+
+fn csv(before: &FairnessMetrics, rows: &[Row]) -> String {
+    let mut s = String::from(
+        "method,inflections,vibrations,sum_displacement,max_displacement,strain_energy,gfi,\
+         seconds,tolerance,tolerance_met,status,note\n",
+    );
+    // Writing to a String cannot fail.
+    let _ = writeln!(
+        s,
+        "input,{},{},,,{},{},,,,,",
+        before.inflections,
+        before.vibrations,
+        csv_num(before.strain_energy),
+        csv_num(before.gfi)
+    );
+    for row in rows {
+        let tol = row.tolerance.map(csv_num).unwrap_or_default();
+        let note = csv_field(&row.note.clone().unwrap_or_default());
+        let _ = match &row.outcome {
+            Outcome::Ran(r) => writeln!(
+                s,
+                "{},{},{},{},{},{},{},{},{tol},{},{},{note}",
+                row.method,
+                r.after.inflections,
+                r.after.vibrations,
+                csv_num(r.sum_displacement),
+                csv_num(r.max_displacement),
+                csv_num(r.after.strain_energy),
+                csv_num(r.after.gfi),
+                csv_num(r.elapsed_seconds),
+                r.tolerance_met,
+                status_name(r),
+            ),
+            Outcome::Failed(msg) => writeln!(
+                s,
+                "{},,,,,,,,{tol},,failed,{}",
+                row.method,
+                csv_field(&join_note(row.note.as_deref(), msg))
+            ),
+            Outcome::Skipped(why) => writeln!(
+                s,
+                "{},,,,,,,,{tol},,skipped,{}",
+                row.method,
+                csv_field(&join_note(row.note.as_deref(), why))
+            ),
+        };
+    }
+    s
+}
+
+fn join_note(note: Option<&str>, extra: &str) -> String {
+    match note {
+        Some(n) => format!("{n}; {extra}"),
+        None => extra.to_string(),
+    }
+}
+
+/// The report's status as serialised (`converged`, `tolerance_exceeded`, ...).
+fn status_name(r: &FairReport) -> String {
+    serde_json::to_value(r.status)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_else(|| format!("{:?}", r.status))
+}
+
+fn to_json(name: &str, base: &FairOptions, before: &FairnessMetrics, rows: &[Row]) -> Value {
+    let rows: Vec<Value> = rows
+        .iter()
+        .map(|row| {
+            let mut v = json!({
+                "method": row.method,
+                "tolerance": row.tolerance,
+                "note": row.note,
+            });
+            let extra = match &row.outcome {
+                Outcome::Ran(r) => json!({
+                    "status": status_name(r),
+                    "inflections": r.after.inflections,
+                    "vibrations": r.after.vibrations,
+                    "sum_displacement": r.sum_displacement,
+                    "max_displacement": r.max_displacement,
+                    "strain_energy": r.after.strain_energy,
+                    "gfi": r.after.gfi,
+                    "seconds": r.elapsed_seconds,
+                    "tolerance_met": r.tolerance_met,
+                    "iterations": r.iterations,
+                    "parameters": r.parameters,
+                    "after": r.after,
+                }),
+                Outcome::Failed(msg) => json!({ "status": "failed", "error": msg }),
+                Outcome::Skipped(why) => json!({ "status": "skipped", "error": why }),
+            };
+            if let (Some(obj), Value::Object(more)) = (v.as_object_mut(), extra) {
+                obj.extend(more);
+            }
+            v
+        })
+        .collect();
+    json!({
+        "input": name,
+        "tolerance": base.tolerance,
+        "fix_ends": base.fix_ends,
+        "before": before,
+        "rows": rows,
+    })
+}

@@ -1,0 +1,117 @@
+//! `batten fair`: fair a point file, write the result and the report.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::anyhow;
+use batten::fair::{self, FairReport};
+use batten::io::{self, Format, PointData, format_f64};
+
+use crate::FairArgs;
+use crate::failure::{EXIT_FAILED, Failure};
+use crate::input;
+use crate::output::{self, sig};
+
+/// Significant digits in the summary line.
+const DIGITS: usize = 4;
+
+/// Run `batten fair`. Everything that can be checked before fairing is checked first, so a
+/// usage error never leaves a partial result behind.
+///
+/// # Errors
+/// Usage errors (exit 2); a method failure or a failed write (exit 1).
+pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
+    let name = args
+        .method
+        .as_deref()
+        .unwrap_or_else(|| fair::default_method());
+    let method = input::method(name)?;
+    let params = input::parse_sets(&args.set)?;
+    let options = input::options(args.tolerance, args.fix_ends, args.max_iterations, params);
+    input::check(method, args.closed, &options)?;
+    Format::from_path(&args.output).map_err(Failure::usage)?;
+
+    let data = input::read(&args.input, args.closed)?;
+    // A JSON file can make the curve closed: check the method against that too.
+    input::check(method, data.seq.is_closed(), &options)?;
+    io::ensure_distinct(&args.input, &args.output).map_err(Failure::usage)?;
+    if let Some(report) = &args.report {
+        io::ensure_distinct(&args.input, report).map_err(Failure::usage)?;
+        if same_path(report, &args.output) {
+            return Err(Failure::usage(anyhow!(
+                "--report and --output both name {}",
+                report.display()
+            )));
+        }
+    }
+
+    let input_name = args.input.display();
+    let faired = fair::fair_with(method, &data.seq, &options).map_err(|e| {
+        Failure::from_batten(&format!("{input_name}: method {} failed", method.name()), e)
+    })?;
+
+    // Tangents: the method's, else the input's carried through.
+    let tangents = faired.tangents.as_deref().or(data.tangents.as_deref());
+    io::write_points(&args.output, &faired.points, data.seq.is_closed(), tangents)
+        .map_err(Failure::failed)?;
+    if let Some(path) = &args.report {
+        write_report(path, &faired.report)?;
+    }
+
+    output::note(&summary(&faired.report, &data));
+    if faired.report.tolerance_met {
+        Ok(ExitCode::SUCCESS)
+    } else {
+        output::error_line(&format!(
+            "tolerance {} not met: a point moved {}; output{} written anyway",
+            faired.report.tolerance.map_or_else(String::new, format_f64),
+            sig(faired.report.max_displacement, DIGITS),
+            if args.report.is_some() {
+                " and report"
+            } else {
+                ""
+            },
+        ));
+        Ok(ExitCode::from(EXIT_FAILED))
+    }
+}
+
+/// Whether two paths name the same file, as far as can be told before either exists.
+fn same_path(a: &Path, b: &Path) -> bool {
+    let abs = |p: &Path| -> PathBuf { std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()) };
+    abs(a) == abs(b)
+}
+
+/// Write the report as pretty JSON, atomically.
+fn write_report(path: &Path, report: &FairReport) -> Result<(), Failure> {
+    let mut json = serde_json::to_string_pretty(report)
+        .map_err(|e| Failure::failed(anyhow!("cannot encode the report: {e}")))?;
+    json.push('\n');
+    io::write_atomic(path, json.as_bytes()).map_err(Failure::failed)
+}
+
+/// The one-line summary: method, status, iterations, largest displacement (and where),
+/// tolerance.
+fn summary(r: &FairReport, data: &PointData) -> String {
+    let status = serde_json::to_value(r.status)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_else(|| format!("{:?}", r.status));
+    let at = match data.lines.get(r.max_displacement_index) {
+        Some(line) if r.max_displacement > 0.0 => {
+            format!(" at point {} (line {line})", r.max_displacement_index)
+        }
+        _ => String::new(),
+    };
+    let tolerance = match r.tolerance {
+        None => "no tolerance".to_string(),
+        Some(t) if r.tolerance_met => format!("tolerance {} met", format_f64(t)),
+        Some(t) => format!("tolerance {} NOT met", format_f64(t)),
+    };
+    format!(
+        "{}: {status}, {} iterations, max displacement {}{at}, {tolerance}",
+        r.method,
+        r.iterations,
+        sig(r.max_displacement, DIGITS),
+    )
+}

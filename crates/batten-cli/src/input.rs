@@ -1,0 +1,116 @@
+//! What the subcommands share: reading the input, building options, checking methods.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::anyhow;
+use batten::FairOptions;
+use batten::fair::{self, FairMethod};
+use batten::io::{self, PointData, ReadOptions};
+
+use crate::failure::Failure;
+
+/// Read and validate the input point file; every problem is a usage error (exit 2) naming
+/// the file and line.
+///
+/// # Errors
+/// [`Failure::usage`] with the [`io::IoError`] message.
+pub fn read(path: &Path, closed: bool) -> Result<PointData, Failure> {
+    io::read_points(path, &ReadOptions::default().with_closed(closed)).map_err(Failure::usage)
+}
+
+/// Parse `--set KEY=VALUE` arguments. Keys and values are trimmed; the key must be
+/// non-empty and given once.
+///
+/// # Errors
+/// [`Failure::usage`] naming the malformed or repeated argument.
+pub fn parse_sets(sets: &[String]) -> Result<BTreeMap<String, String>, Failure> {
+    let mut params = BTreeMap::new();
+    for s in sets {
+        let Some((k, v)) = s.split_once('=') else {
+            return Err(Failure::usage(anyhow!(
+                "malformed --set '{}': expected KEY=VALUE",
+                s.escape_debug()
+            )));
+        };
+        let (k, v) = (k.trim(), v.trim());
+        if k.is_empty() {
+            return Err(Failure::usage(anyhow!(
+                "malformed --set '{}': the key is empty",
+                s.escape_debug()
+            )));
+        }
+        if params.insert(k.to_string(), v.to_string()).is_some() {
+            return Err(Failure::usage(anyhow!("--set {k} is given more than once")));
+        }
+    }
+    Ok(params)
+}
+
+/// Look a method up.
+///
+/// # Errors
+/// [`Failure::usage`] with the library's "unknown method" message listing the known ones.
+pub fn method(name: &str) -> Result<&'static dyn FairMethod, Failure> {
+    fair::method(name).map_err(|e| Failure::from_batten("", e))
+}
+
+/// Check the options against the method (unknown keys, tolerance, closed support).
+///
+/// # Errors
+/// [`Failure::usage`].
+pub fn check(m: &dyn FairMethod, closed: bool, options: &FairOptions) -> Result<(), Failure> {
+    fair::check_options(m, closed, options).map_err(|e| Failure::from_batten("", e))
+}
+
+/// Options from the common flags.
+pub fn options(
+    tolerance: Option<f64>,
+    fix_ends: bool,
+    max_iterations: Option<usize>,
+    params: BTreeMap<String, String>,
+) -> FairOptions {
+    let mut o = FairOptions::default().with_fix_ends(fix_ends);
+    o.tolerance = tolerance;
+    o.max_iterations = max_iterations;
+    o.params = params;
+    o
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    fn sets(v: &[&str]) -> Result<BTreeMap<String, String>, String> {
+        let owned: Vec<String> = v.iter().map(|s| s.to_string()).collect();
+        parse_sets(&owned).map_err(|f| f.error.to_string())
+    }
+
+    #[test]
+    fn set_arguments() {
+        let p = sets(&["p=0.5", " lambda = 2 "]).unwrap();
+        assert_eq!(p.get("p").map(String::as_str), Some("0.5"));
+        assert_eq!(p.get("lambda").map(String::as_str), Some("2"));
+        assert_eq!(
+            sets(&["a=b=c"]).unwrap().get("a").map(String::as_str),
+            Some("b=c")
+        );
+        assert_eq!(
+            sets(&["p"]).unwrap_err(),
+            "malformed --set 'p': expected KEY=VALUE"
+        );
+        assert_eq!(
+            sets(&["=3"]).unwrap_err(),
+            "malformed --set '=3': the key is empty"
+        );
+        assert_eq!(
+            sets(&["p=1", "p=2"]).unwrap_err(),
+            "--set p is given more than once"
+        );
+        assert_eq!(
+            sets(&["a\nb"]).unwrap_err(),
+            "malformed --set 'a\\nb': expected KEY=VALUE"
+        );
+    }
+}

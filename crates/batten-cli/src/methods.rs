@@ -1,0 +1,75 @@
+//! `batten methods`: the registry, for people.
+
+use std::fmt::Write as _;
+use std::process::ExitCode;
+
+use batten::fair::{self, FairMethod};
+
+use crate::failure::Failure;
+use crate::output;
+
+/// Run `batten methods`.
+///
+/// # Errors
+/// Only a failed write to stdout.
+pub fn run() -> Result<ExitCode, Failure> {
+    output::stdout(&listing(fair::methods(), fair::default_method()))?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// One block per method: name (and whether it is the default), description, closed-curve
+/// support, parameters with default and doc.
+fn listing(methods: &[&dyn FairMethod], default: &str) -> String {
+    let mut s = String::new();
+    for (i, m) in methods.iter().enumerate() {
+        if i > 0 {
+            s.push('\n');
+        }
+        let tag = if m.name() == default {
+            " (default)"
+        } else {
+            ""
+        };
+        // Writing to a String cannot fail.
+        let _ = writeln!(s, "{}{tag}", m.name());
+        let _ = writeln!(s, "  {}", m.description());
+        let closed = if m.supports_closed() { "yes" } else { "no" };
+        let _ = writeln!(s, "  closed curves: {closed}");
+        let params = m.parameters();
+        if params.is_empty() {
+            s.push_str("  parameters: none\n");
+            continue;
+        }
+        s.push_str("  parameters (--set KEY=VALUE):\n");
+        let width = params
+            .iter()
+            .map(|p| p.name.len() + p.default.len() + 1)
+            .max()
+            .unwrap_or(0);
+        for p in params {
+            let kv = format!("{}={}", p.name, p.default);
+            let _ = writeln!(s, "    {kv:<width$}  {}", p.doc);
+        }
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lists_every_registered_method_with_its_parameters() {
+        let text = listing(fair::methods(), fair::default_method());
+        for m in fair::methods() {
+            assert!(text.contains(m.name()), "{text}");
+            for p in m.parameters() {
+                assert!(
+                    text.contains(&format!("{}={}", p.name, p.default)),
+                    "{text}"
+                );
+            }
+        }
+        assert!(text.contains(&format!("{} (default)", fair::default_method())));
+    }
+}

@@ -1,0 +1,89 @@
+//! Writing to stdout and stderr, and formatting numbers for people.
+
+use std::io::{ErrorKind, Write as _};
+
+use anyhow::anyhow;
+
+use crate::failure::Failure;
+
+/// Write `text` to stdout. A closed pipe is not an error (the reader has what it wanted).
+///
+/// # Errors
+/// Any other write error, as a [`Failure::failed`].
+pub fn stdout(text: &str) -> Result<(), Failure> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => Err(Failure::failed(anyhow!(
+            "cannot write to standard output: {e}"
+        ))),
+    }
+}
+
+/// Write one line to stderr. There is nowhere to report a failure to write stderr.
+pub fn note(line: &str) {
+    let _ = writeln!(std::io::stderr().lock(), "{line}");
+}
+
+/// Write an error line to stderr: `error: MESSAGE`.
+pub fn error_line(message: &str) {
+    note(&format!("error: {message}"));
+}
+
+/// `x` with `digits` significant digits: fixed notation for magnitudes in `[1e-3, 1e6)`,
+/// exponent notation otherwise (`1.234e9`).
+pub fn sig(x: f64, digits: usize) -> String {
+    if !x.is_finite() {
+        return x.to_string();
+    }
+    if x == 0.0 {
+        return "0".to_string();
+    }
+    let digits = digits.max(1);
+    let exp = x.abs().log10().floor();
+    if (-3.0..6.0).contains(&exp) {
+        // exp is a small integer here, so the conversion is exact.
+        let decimals = (digits as f64 - 1.0 - exp).max(0.0) as usize;
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.prec$e}", prec = digits - 1)
+    }
+}
+
+/// A duration in seconds, in the unit that suits it (`412 µs`, `12.3 ms`, `1.25 s`).
+pub fn seconds(s: f64) -> String {
+    if s < 1e-3 {
+        format!("{:.0} µs", s * 1e6)
+    } else if s < 1.0 {
+        format!("{:.1} ms", s * 1e3)
+    } else {
+        format!("{s:.2} s")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn significant_digits() {
+        assert_eq!(sig(0.0, 4), "0");
+        assert_eq!(sig(1.23456, 4), "1.235");
+        assert_eq!(sig(-123.456, 4), "-123.5");
+        assert_eq!(sig(0.0012345, 3), "0.00123");
+        assert_eq!(sig(1.5e9, 4), "1.500e9");
+        assert_eq!(sig(2.5e-7, 2), "2.5e-7");
+        assert_eq!(sig(123456.0, 4), "123456");
+        assert_eq!(sig(1234567.0, 4), "1.235e6");
+        assert_eq!(sig(f64::INFINITY, 4), "inf");
+        assert_eq!(sig(f64::NAN, 4), "NaN");
+    }
+
+    #[test]
+    fn durations() {
+        assert_eq!(seconds(0.000412), "412 µs");
+        assert_eq!(seconds(0.0123), "12.3 ms");
+        assert_eq!(seconds(1.25), "1.25 s");
+    }
+}
