@@ -5,19 +5,19 @@
 //!
 //! # The algorithm
 //!
-//! 1. Interpolate the points `Q_0..Q_n` by a clamped degree-p B-spline (spec §4.3 [CHOICE]:
+//! 1. Interpolate the points `Q_0..Q_n` by a clamped degree-p B-spline (spec §4.3 \[CHOICE\]:
 //!    chord-length parameters normalised to [0, 1], averaging knots; [`BSplineCurve::interpolate`]),
 //!    so there are m + 1 = n + 1 control points.
-//! 2. Compute the indicators of spec §4.4 [CHOICE]: the signed curvature `κ_j` and arc length
+//! 2. Compute the indicators of spec §4.4 \[CHOICE\]: the signed curvature `κ_j` and arc length
 //!    `s_j` at the correspondence points `ξ_j`, `LFI_j = (κ''_j)²` from the second divided
 //!    difference of κ with respect to s (j = 1..m−1), `GFI = Σ LFI_j`
 //!    ([`crate::analysis::fairness_indicators`]).
 //! 3. Take the candidates i = 2..m−2 in order of descending `LFI_i`. For each, move the five
 //!    control points `P_{i−2..i+2}` to `(M^λ P)_j` ([`LambdaOperator`], spec §4.2, with the
 //!    γ_0/α_m fix), λ minimising `LFI_i(λ)` on [0, 1] by a golden section to `lambda_tol`
-//!    with both end points compared (spec §4.5 [CHOICE]). `P_0` and `P_m` are never changed
-//!    (spec §4.5 [CHOICE]), so the curve keeps its end points.
-//! 4. Accept the first candidate with `GFI_new < τ·GFI` (τ = 0.99 [PAPER]) and go back to 2;
+//!    with both end points compared (spec §4.5 \[CHOICE\]). `P_0` and `P_m` are never changed
+//!    (spec §4.5 \[CHOICE\]), so the curve keeps its end points.
+//! 4. Accept the first candidate with `GFI_new < τ·GFI` (τ = 0.99 \[PAPER\]) and go back to 2;
 //!    the knots are never changed and the curve is not re-interpolated.
 //! 5. Stop when no candidate is accepted (the paper's "if i is the last point the procedure is
 //!    finished"). The result is the B-spline with the final control points.
@@ -45,6 +45,19 @@
 //! The first and last output points are always the input's: the curve is clamped, so they
 //! are `P_0` and `P_m`, which are set to the input's ends after the interpolation (the banded
 //! solve may leave a rounding error there) and never move.
+//!
+//! # Report
+//!
+//! - `moves`: one per accepted move, `index` = the centre i, `before`/`after` = the GFI,
+//!   `distance` = the largest control-point displacement of the move;
+//! - `history`: the GFI trend of the paper's Figures 7, 11 and 15 — row 0 is the interpolant,
+//!   then one row per accepted move, with the largest output-point displacement so far;
+//! - `parameters`: `tau`, `lambda_tol`, `degree`, `max_moves`, `parametrization`,
+//!   `gfi_initial`, `gfi_final`, and `lambdas` (λ* of each accepted move);
+//! - status: `converged` when a full pass accepted nothing after at least one move,
+//!   `no_change` when nothing was ever accepted, `tolerance_limited` when the last pass refused
+//!   a move that would have been accepted but for the tolerance, `iteration_limit` when
+//!   `max_iterations` moves were made.
 //!
 //! # Degenerate input
 //!
@@ -93,7 +106,7 @@ use crate::spline::{
 /// The relaxation factor τ of the acceptance test `GFI_new < τ·GFI` (paper §5, spec §4.5).
 pub const DEFAULT_TAU: f64 = 0.99;
 
-/// Default absolute tolerance in λ of the golden-section search (spec §4.5 [CHOICE]).
+/// Default absolute tolerance in λ of the golden-section search (spec §4.5 \[CHOICE\]).
 pub const DEFAULT_LAMBDA_TOL: f64 = 1e-6;
 
 /// Default spline degree: cubic, as in the paper's tests.
@@ -793,7 +806,7 @@ impl LocalIndicators {
     }
 
     /// The move centred at `i` with the λ that minimises `LFI_i(λ)` on [0, 1]: golden section
-    /// to `lambda_tol`, both end points compared (spec §4.5 [CHOICE]).
+    /// to `lambda_tol`, both end points compared (spec §4.5 \[CHOICE\]).
     ///
     /// # Errors
     /// As [`LocalIndicators::lfi_after`], and [`Error::InvalidParameter`] for a `lambda_tol`

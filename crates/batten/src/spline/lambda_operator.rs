@@ -22,7 +22,7 @@
 //!   β_i = 1 − α_i − γ_i
 //!   ```
 //!
-//! Spec §4.2 [FIX]: the paper lists γ_i only for i = 1..m−1 although its matrix uses γ_0, and
+//! Spec §4.2 \[FIX\]: the paper lists γ_i only for i = 1..m−1 although its matrix uses γ_0, and
 //! prints the last row as "β_m γ_m" instead of "α_m β_m". Here γ_0 > 0 and α_m > 0, so the
 //! end control points move under `M^λ` (the fairing method keeps them fixed itself).
 //!
