@@ -14,7 +14,7 @@ use batten::fair::{self, FairMethod, FairReport};
 use batten::io::format_f64;
 use batten::{FairOptions, FairnessMetrics, PointSeq};
 use rayon::prelude::*;
-use serde_json::{Value, json};
+use serde::Serialize;
 
 use crate::failure::{EXIT_FAILED, Failure};
 use crate::input;
@@ -340,44 +340,90 @@ fn status_name(r: &FairReport) -> String {
         .unwrap_or_else(|| format!("{:?}", r.status))
 }
 
-fn to_json(name: &str, base: &FairOptions, before: &FairnessMetrics, rows: &[Row]) -> Value {
-    let rows: Vec<Value> = rows
+/// The `--format json` document. Structs rather than `json!` so that keys keep this order.
+#[derive(Serialize)]
+struct CompareJson<'a> {
+    input: &'a str,
+    tolerance: Option<f64>,
+    fix_ends: bool,
+    before: &'a FairnessMetrics,
+    rows: Vec<RowJson<'a>>,
+}
+
+/// One row: what was asked, how it ended, and for a run the table's numbers, the parameters
+/// used and the full metrics after fairing.
+#[derive(Serialize)]
+struct RowJson<'a> {
+    method: &'a str,
+    tolerance: Option<f64>,
+    note: Option<&'a str>,
+    status: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    error: Option<&'a str>,
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    result: Option<RunJson<'a>>,
+}
+
+#[derive(Serialize)]
+struct RunJson<'a> {
+    inflections: usize,
+    vibrations: usize,
+    sum_displacement: f64,
+    max_displacement: f64,
+    strain_energy: f64,
+    gfi: f64,
+    seconds: f64,
+    tolerance_met: bool,
+    iterations: usize,
+    parameters: &'a serde_json::Map<String, serde_json::Value>,
+    after: &'a FairnessMetrics,
+}
+
+fn to_json<'a>(
+    name: &'a str,
+    base: &FairOptions,
+    before: &'a FairnessMetrics,
+    rows: &'a [Row],
+) -> CompareJson<'a> {
+    let rows = rows
         .iter()
         .map(|row| {
-            let mut v = json!({
-                "method": row.method,
-                "tolerance": row.tolerance,
-                "note": row.note,
-            });
-            let extra = match &row.outcome {
-                Outcome::Ran(r) => json!({
-                    "status": status_name(r),
-                    "inflections": r.after.inflections,
-                    "vibrations": r.after.vibrations,
-                    "sum_displacement": r.sum_displacement,
-                    "max_displacement": r.max_displacement,
-                    "strain_energy": r.after.strain_energy,
-                    "gfi": r.after.gfi,
-                    "seconds": r.elapsed_seconds,
-                    "tolerance_met": r.tolerance_met,
-                    "iterations": r.iterations,
-                    "parameters": r.parameters,
-                    "after": r.after,
-                }),
-                Outcome::Failed(msg) => json!({ "status": "failed", "error": msg }),
-                Outcome::Skipped(why) => json!({ "status": "skipped", "error": why }),
+            let (status, error, result) = match &row.outcome {
+                Outcome::Ran(r) => (
+                    status_name(r),
+                    None,
+                    Some(RunJson {
+                        inflections: r.after.inflections,
+                        vibrations: r.after.vibrations,
+                        sum_displacement: r.sum_displacement,
+                        max_displacement: r.max_displacement,
+                        strain_energy: r.after.strain_energy,
+                        gfi: r.after.gfi,
+                        seconds: r.elapsed_seconds,
+                        tolerance_met: r.tolerance_met,
+                        iterations: r.iterations,
+                        parameters: &r.parameters,
+                        after: &r.after,
+                    }),
+                ),
+                Outcome::Failed(msg) => ("failed".to_string(), Some(msg.as_str()), None),
+                Outcome::Skipped(why) => ("skipped".to_string(), Some(why.as_str()), None),
             };
-            if let (Some(obj), Value::Object(more)) = (v.as_object_mut(), extra) {
-                obj.extend(more);
+            RowJson {
+                method: row.method,
+                tolerance: row.tolerance,
+                note: row.note.as_deref(),
+                status,
+                error,
+                result,
             }
-            v
         })
         .collect();
-    json!({
-        "input": name,
-        "tolerance": base.tolerance,
-        "fix_ends": base.fix_ends,
-        "before": before,
-        "rows": rows,
-    })
+    CompareJson {
+        input: name,
+        tolerance: base.tolerance,
+        fix_ends: base.fix_ends,
+        before,
+        rows,
+    }
 }

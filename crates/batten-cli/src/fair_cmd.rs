@@ -30,6 +30,10 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
     let options = input::options(args.tolerance, args.fix_ends, args.max_iterations, params);
     input::check(method, args.closed, &options)?;
     Format::from_path(&args.output).map_err(Failure::usage)?;
+    check_directory(&args.output)?;
+    if let Some(report) = &args.report {
+        check_directory(report)?;
+    }
 
     let data = input::read(&args.input, args.closed)?;
     // A JSON file can make the curve closed: check the method against that too.
@@ -73,6 +77,23 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
             },
         ));
         Ok(ExitCode::from(EXIT_FAILED))
+    }
+}
+
+/// A file can only be written into a directory that exists: say so before fairing.
+fn check_directory(path: &Path) -> Result<(), Failure> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if dir.is_dir() {
+        Ok(())
+    } else {
+        Err(Failure::usage(anyhow!(
+            "{}: cannot write: directory {} does not exist",
+            path.display(),
+            dir.display()
+        )))
     }
 }
 

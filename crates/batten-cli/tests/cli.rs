@@ -220,6 +220,13 @@ fn bad_options_exit_2_before_anything_runs() {
     let o = batten(&["fair", s(&input), "-o", s(&d.join("out.xyz"))]);
     assert_usage_error(&o, &["out.xyz: unknown file format"]);
     assert!(!d.join("out.xyz").exists());
+    // An output or report in a directory that does not exist is refused before fairing.
+    let nowhere = d.join("no/such/dir/out.csv");
+    let o = batten(&["fair", s(&input), "-o", s(&nowhere)]);
+    assert_usage_error(&o, &["out.csv: cannot write: directory", "does not exist"]);
+    let o = batten(&["fair", s(&input), "-o", s(&out), "--report", s(&nowhere)]);
+    assert_usage_error(&o, &["does not exist"]);
+    assert!(!out.exists());
     // compare: unknown or repeated methods.
     assert_usage_error(
         &batten(&["compare", s(&input), "--methods", "mst,nope"]),
