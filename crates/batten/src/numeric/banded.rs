@@ -80,7 +80,7 @@ impl SymBanded {
                 let l = self.band[i * w + (i - k)];
                 d -= l * l * self.band[k * w];
             }
-            if !(d > PIVOT_REL * scale) || !d.is_finite() {
+            if d.is_nan() || d <= PIVOT_REL * scale || !d.is_finite() {
                 return Err(Error::Singular(format!(
                     "band matrix is not positive definite (pivot {i})"
                 )));
