@@ -6,6 +6,7 @@ mod band_inverse;
 mod banded;
 mod cyclic_banded;
 mod minimize;
+mod nelder_mead;
 mod quadrature;
 mod tridiagonal;
 
@@ -16,6 +17,7 @@ pub use band_inverse::factorize_with_inverse_band;
 pub use banded::SymBanded;
 pub use cyclic_banded::CyclicSymBanded;
 pub use minimize::{Minimum, minimize_brent, minimize_golden};
+pub use nelder_mead::{NelderMeadParams, SimplexMinimum, minimize_nelder_mead};
 pub use quadrature::GaussLegendre;
 pub use tridiagonal::{solve_cyclic_tridiagonal, solve_tridiagonal};
 
