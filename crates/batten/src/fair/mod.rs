@@ -11,17 +11,22 @@
 //! in [`methods`].
 
 pub mod cali;
+pub mod eck_hadenfeld;
 pub mod han;
+pub mod local;
 mod options;
 mod report;
+pub mod salvi;
 pub mod smoothing;
 
 use std::time::Instant;
 
 pub use cali::Cali;
+pub use eck_hadenfeld::EckHadenfeld;
 pub use han::Han;
 pub use options::{FairOptions, ParamSpec};
 pub use report::{FairReport, FairStatus, HistoryRow, Move};
+pub use salvi::Salvi;
 pub use smoothing::{Mst, Smoothing, SmoothingInfo, SmoothingSpline, SmoothingTrial};
 
 use crate::analysis::{FairnessMetrics, displacement};
@@ -85,8 +90,10 @@ pub struct Faired {
 static MST: Mst = Mst;
 static CALI: Cali = Cali;
 static HAN: Han = Han;
+static SALVI: Salvi = Salvi;
+static ECK_HADENFELD: EckHadenfeld = EckHadenfeld;
 
-static REGISTRY: &[&dyn FairMethod] = &[&MST, &HAN, &CALI];
+static REGISTRY: &[&dyn FairMethod] = &[&MST, &HAN, &CALI, &SALVI, &ECK_HADENFELD];
 
 /// Every registered method, the default first.
 pub fn methods() -> &'static [&'static dyn FairMethod] {

@@ -1,0 +1,585 @@
+//! `eck-hadenfeld`: local energy fairing of a B-spline curve, one control point at a time,
+//! after M. Eck and J. Hadenfeld, *Local energy fairing of B-spline curves* (Computing Suppl.
+//! 10, 1995), as Salvi and Várady review it (`../shared/papers/salvi-varady-local-fairing.txt`,
+//! §3.2, eqs 9–11); the selection, recently-moved list and clamp are those of spec §3
+//! (`../shared/spec/ALGORITHMS.md`, steps 5, 7, 8), shared with [`super::salvi`].
+//!
+//! # The algorithm
+//!
+//! The energy (eq 9, which misses its `dt` in the print — spec §3 OCR notes) is
+//! `E_l = ∫ |x^{(l)}(t)|² dt` over the domain, `l = 2` or `3`. With knots and weights fixed,
+//! `x = Σ d_i R_i` is linear in the control points, so
+//! `E_l = Σ_a Σ_b G_ab d_a·d_b` with the Gram matrix `G_ab = ∫ R_a^{(l)} R_b^{(l)} dt` of the
+//! l-th derivatives of the (rational) basis functions. G is banded (`|a − b| ≤ p`); its band
+//! is computed once, span by span, by Gauss–Legendre quadrature ([`Gram`]): `p − l + 1` nodes
+//! integrate the polynomial integrand of a non-rational curve exactly, rational curves use
+//! [`RATIONAL_GRAM_NODES`].
+//!
+//! As a function of one control point `d_j`, `E_l = G_jj |d_j − d_j*|² + const` with
+//!
+//! ```text
+//! d_j* = −(Σ_{i≠j} G_ji d_i) / G_jj,
+//! ```
+//!
+//! the closed-form local minimiser. Because this quadratic is isotropic, the eq-11 clamp of
+//! `d_j*` towards the **original** `d_j⁰` is exactly the minimiser over the disc
+//! `|d_j − d_j⁰| ≤ δ`, and since the current `d_j` lies in that disc a move never raises the
+//! energy.
+//!
+//! Each iteration moves the movable control point (all but the ends unless `free_ends`) not in
+//! the recently-moved list whose clamped move lowers the energy most, `G_jj(|d_j − d_j*|² −
+//! |d̃_j − d_j*|²)` — the local deviation of this method. The run stops when no single move
+//! can lower the energy by more than [`DEFAULT_MIN_REL_DECREASE`] of its value, when the energy
+//! is zero, or at `max_iterations`. Only the `2p + 1` neighbours' sums `Σ_{i≠j} G_ji d_i`
+//! and gains change after a move; they are recomputed exactly from the band (O(p²)).
+//!
+//! Without a tolerance, δ = [`super::local::DEFAULT_TOLERANCE_REL`] × the bounding-box
+//! diagonal of the data; point input is handled as in [`super::salvi`].
+
+use serde_json::Value;
+
+use super::local::{
+    self, DEFAULT_TABU_LENGTH, FIT_PARAMS, LocalReport, RecentList, RunningMax, clamp_point,
+    movable_mask, resolve_tolerance, select_candidate,
+};
+use super::salvi::insert_common;
+use super::{FairMethod, FairOptions, FairStatus, HistoryRow, Move, Outcome, ParamSpec};
+use crate::error::{Error, Result};
+use crate::geom::{Point, PointSeq, Vec2};
+use crate::numeric::GaussLegendre;
+use crate::spline::{BSplineCurve, MAX_ORDER};
+
+/// Default derivative order l of the energy.
+pub const DEFAULT_ORDER: usize = 2;
+
+/// Default iteration limit (one control point per iteration).
+pub const DEFAULT_MAX_ITERATIONS: usize = 1000;
+
+/// Stop when the best single move would lower the energy by less than this fraction of it.
+pub const DEFAULT_MIN_REL_DECREASE: f64 = 1e-9;
+
+/// Gauss–Legendre nodes per span for the Gram matrix of a rational curve (its integrand is not
+/// a polynomial).
+pub const RATIONAL_GRAM_NODES: usize = GaussLegendre::DEFAULT_NODES;
+
+/// Parameters of [`fair_curve`]. Start from [`EckHadenfeldParams::DEFAULT`].
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct EckHadenfeldParams {
+    /// Derivative order l of the energy ∫|x^{(l)}|² dt: 2 or 3.
+    ///
+    /// Default value: [`DEFAULT_ORDER`] (2).
+    pub order: usize,
+    /// δ, the largest distance of a control point from its original position; `None`:
+    /// [`local::DEFAULT_TOLERANCE_REL`] × the bounding-box diagonal of the control points.
+    ///
+    /// Default value: `None`.
+    pub tolerance: Option<f64>,
+    /// Length R of the recently-moved list.
+    ///
+    /// Default value: [`DEFAULT_TABU_LENGTH`] (4).
+    pub tabu_length: usize,
+    /// Iteration limit.
+    ///
+    /// Default value: [`DEFAULT_MAX_ITERATIONS`] (1000).
+    pub max_iterations: usize,
+    /// Stop when no move lowers the energy by more than this fraction of it.
+    ///
+    /// Default value: [`DEFAULT_MIN_REL_DECREASE`].
+    pub min_rel_decrease: f64,
+    /// Let the first and last control points move.
+    ///
+    /// Default value: `false`.
+    pub free_ends: bool,
+}
+
+impl EckHadenfeldParams {
+    /// The defaults listed on each field.
+    pub const DEFAULT: EckHadenfeldParams = EckHadenfeldParams {
+        order: DEFAULT_ORDER,
+        tolerance: None,
+        tabu_length: DEFAULT_TABU_LENGTH,
+        max_iterations: DEFAULT_MAX_ITERATIONS,
+        min_rel_decrease: DEFAULT_MIN_REL_DECREASE,
+        free_ends: false,
+    };
+
+    /// Set the order l.
+    pub fn with_order(mut self, order: usize) -> EckHadenfeldParams {
+        self.order = order;
+        self
+    }
+
+    /// Set δ.
+    pub fn with_tolerance(mut self, delta: f64) -> EckHadenfeldParams {
+        self.tolerance = Some(delta);
+        self
+    }
+
+    /// Set the iteration limit.
+    pub fn with_max_iterations(mut self, n: usize) -> EckHadenfeldParams {
+        self.max_iterations = n;
+        self
+    }
+
+    /// Set the relative-decrease threshold of the stopping rule (0: run to the limit or until
+    /// no move helps at all).
+    pub fn with_min_rel_decrease(mut self, v: f64) -> EckHadenfeldParams {
+        self.min_rel_decrease = v;
+        self
+    }
+
+    /// Set the tabu length R.
+    pub fn with_tabu_length(mut self, r: usize) -> EckHadenfeldParams {
+        self.tabu_length = r;
+        self
+    }
+
+    /// Free (or fix) the end control points.
+    pub fn with_free_ends(mut self, free: bool) -> EckHadenfeldParams {
+        self.free_ends = free;
+        self
+    }
+}
+
+impl Default for EckHadenfeldParams {
+    fn default() -> EckHadenfeldParams {
+        EckHadenfeldParams::DEFAULT
+    }
+}
+
+/// The band of the Gram matrix `G_ab = ∫ R_a^{(l)}(t) R_b^{(l)}(t) dt` of a B-spline's
+/// (rational) basis functions over its domain.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Gram {
+    p: usize,
+    n: usize,
+    /// `band[a·(p+1) + k] = G[a][a+k]`, k = 0..=p.
+    band: Vec<f64>,
+}
+
+impl Gram {
+    /// The Gram matrix of the order-`order` derivatives of the basis of `curve`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for an order outside `1..=3` or above the degree (the
+    /// energy would vanish identically).
+    pub fn new(curve: &BSplineCurve, order: usize) -> Result<Gram> {
+        let p = curve.degree();
+        if !(1..=3).contains(&order) || order > p {
+            return Err(Error::InvalidParameter {
+                name: "order".into(),
+                reason: format!("must be in 1..=3 and at most the degree {p}, got {order}"),
+            });
+        }
+        let n = curve.control_points().len();
+        let u = curve.knots().as_slice();
+        let weights = curve.weights();
+        let gl = GaussLegendre::new(match weights {
+            None => p - order + 1,
+            Some(_) => RATIONAL_GRAM_NODES,
+        });
+        let mut band = vec![0.0; n * (p + 1)];
+        let mut b = [[0.0; MAX_ORDER]; 4];
+        let mut r = [0.0; MAX_ORDER];
+        for span in p..n {
+            let (a, bnd) = (u[span], u[span + 1]);
+            if a >= bnd {
+                continue;
+            }
+            let half = 0.5 * (bnd - a);
+            let mid = 0.5 * (a + bnd);
+            for (x, w) in gl.nodes().iter().zip(gl.weights()) {
+                let t = mid + half * x;
+                curve.basis_derivs(span, t, order, &mut b);
+                match weights {
+                    None => r[..=p].copy_from_slice(&b[order][..=p]),
+                    Some(ws) => rational_derivative(&b, &ws[span - p..=span], order, &mut r),
+                }
+                let wt = w * half;
+                for c in 0..=p {
+                    for k in 0..=p - c {
+                        band[(span - p + c) * (p + 1) + k] += wt * r[c] * r[c + k];
+                    }
+                }
+            }
+        }
+        Ok(Gram { p, n, band })
+    }
+
+    /// `G[a][b]` (zero outside the band).
+    pub fn get(&self, a: usize, b: usize) -> f64 {
+        let (a, b) = if a <= b { (a, b) } else { (b, a) };
+        if b - a > self.p || b >= self.n {
+            0.0
+        } else {
+            self.band[a * (self.p + 1) + (b - a)]
+        }
+    }
+
+    /// Half-bandwidth p.
+    pub fn bandwidth(&self) -> usize {
+        self.p
+    }
+
+    /// `Σ_{i≠j} G_ji d_i`, the coupling of control point j to the others.
+    pub fn coupling(&self, d: &[Point], j: usize) -> Vec2 {
+        let lo = j.saturating_sub(self.p);
+        let hi = (j + self.p + 1).min(self.n);
+        let mut s = Vec2::ZERO;
+        for (i, di) in d.iter().enumerate().take(hi).skip(lo) {
+            if i != j {
+                s += di.to_vec2() * self.get(j, i);
+            }
+        }
+        s
+    }
+
+    /// The energy `Σ_a Σ_b G_ab d_a·d_b`.
+    ///
+    /// # Panics
+    /// If `d` has fewer entries than the matrix.
+    pub fn energy(&self, d: &[Point]) -> f64 {
+        let mut e = 0.0;
+        for (a, pa) in d.iter().enumerate().take(self.n) {
+            let da = pa.to_vec2();
+            e += self.get(a, a) * da.length_squared();
+            let hi = (a + self.p + 1).min(self.n);
+            for (b, pb) in d.iter().enumerate().take(hi).skip(a + 1) {
+                e += 2.0 * self.get(a, b) * da.dot(pb.to_vec2());
+            }
+        }
+        e
+    }
+}
+
+/// The order-`o` derivatives of the rational basis `R_c = w_c N_c / W` of one span from the
+/// B-spline basis derivatives `b[k][c]` (k ≤ o): `R^{(o)} = (w N^{(o)} − Σ_{i=1}^{o} C(o,i)
+/// W^{(i)} R^{(o−i)}) / W`.
+fn rational_derivative(b: &[[f64; MAX_ORDER]; 4], w: &[f64], o: usize, out: &mut [f64; MAX_ORDER]) {
+    const BINOM: [[f64; 4]; 4] = [
+        [1.0, 0.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0, 0.0],
+        [1.0, 2.0, 1.0, 0.0],
+        [1.0, 3.0, 3.0, 1.0],
+    ];
+    let mut wd = [0.0; 4];
+    for (k, wk) in wd.iter_mut().enumerate().take(o + 1) {
+        *wk = w.iter().enumerate().map(|(c, wc)| wc * b[k][c]).sum();
+    }
+    for (c, wc) in w.iter().enumerate() {
+        let mut r = [0.0; 4];
+        for k in 0..=o {
+            let mut v = wc * b[k][c];
+            for i in 1..=k {
+                v -= BINOM[k][i] * wd[i] * r[k - i];
+            }
+            r[k] = v / wd[0];
+        }
+        out[c] = r[o];
+    }
+}
+
+/// The energy `∫ |x^{(order)}|² dt` of `curve` (eq 9), through its Gram matrix.
+///
+/// # Errors
+/// As [`Gram::new`].
+pub fn energy(curve: &BSplineCurve, order: usize) -> Result<f64> {
+    Ok(Gram::new(curve, order)?.energy(curve.control_points()))
+}
+
+/// Fair `curve` by local energy minimisation (see the module documentation). Knots, degree and
+/// weights are kept; every control point stays within δ of its original position, so the
+/// curve stays within δ of `curve` (eq 10).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for an order outside 2..=3 or above the degree, a non-positive
+/// tolerance or a negative threshold; [`Error::Degenerate`] when every control point
+/// coincides and no tolerance is given.
+pub fn fair_curve(
+    curve: &BSplineCurve,
+    params: &EckHadenfeldParams,
+) -> Result<(BSplineCurve, LocalReport)> {
+    if !(2..=3).contains(&params.order) {
+        return Err(Error::InvalidParameter {
+            name: "order".into(),
+            reason: format!("must be 2 or 3, got {}", params.order),
+        });
+    }
+    if !(params.min_rel_decrease.is_finite() && params.min_rel_decrease >= 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "min_rel_decrease".into(),
+            reason: format!(
+                "must be finite and non-negative, got {}",
+                params.min_rel_decrease
+            ),
+        });
+    }
+    let delta = resolve_tolerance(params.tolerance, curve)?;
+    let gram = Gram::new(curve, params.order)?;
+    let p = curve.degree();
+    let original: Vec<Point> = curve.control_points().to_vec();
+    let n = original.len();
+    let mut d = original.clone();
+    let movable = movable_mask(n, params.free_ends);
+
+    // The clamped local optimum of j and the energy its move would remove.
+    let best_move = |d: &[Point], j: usize| -> (Point, f64, bool) {
+        let gjj = gram.get(j, j);
+        if gjj.is_nan() || gjj <= 0.0 {
+            return (d[j], 0.0, false);
+        }
+        let star = (gram.coupling(d, j) * (-1.0 / gjj)).to_point();
+        let (c, clamped) = clamp_point(original[j], star, delta);
+        let gain = gjj * ((d[j] - star).length_squared() - (c - star).length_squared());
+        (c, gain.max(0.0), clamped)
+    };
+    let mut gain: Vec<f64> = (0..n)
+        .map(|j| if movable[j] { best_move(&d, j).1 } else { 0.0 })
+        .collect();
+
+    let measure_before = gram.energy(&d);
+    let mut e = measure_before;
+    let mut recent = RecentList::new(params.tabu_length);
+    let mut displacement = RunningMax::zeros(n);
+    let mut history = vec![HistoryRow {
+        iteration: 0,
+        measure: e,
+        max_distance: 0.0,
+    }];
+    let mut moves = Vec::new();
+    let mut clamped_moves = 0;
+    let mut iterations = 0;
+    let mut converged = false;
+    while iterations < params.max_iterations {
+        let best_gain = gain.iter().copied().fold(0.0, f64::max);
+        if e <= 0.0 || best_gain <= params.min_rel_decrease * e {
+            converged = true;
+            break;
+        }
+        let Some(j) = select_candidate(&gain, &movable, &mut recent) else {
+            converged = true;
+            break;
+        };
+        iterations += 1;
+        let (c, g, clamped) = best_move(&d, j);
+        if g > 0.0 && c != d[j] {
+            let old = d[j];
+            let b = gram.coupling(&d, j);
+            let gjj = gram.get(j, j);
+            // E(d_j) = G_jj |d_j|² + 2 d_j·b + const.
+            let change = gjj * (c.to_vec2().length_squared() - old.to_vec2().length_squared())
+                + 2.0 * b.dot(c - old);
+            let before = e;
+            // The change is negative; `min` guards the running energy against rounding.
+            e = (e + change).min(e);
+            d[j] = c;
+            for jj in j.saturating_sub(p)..(j + p + 1).min(n) {
+                gain[jj] = if movable[jj] {
+                    best_move(&d, jj).1
+                } else {
+                    0.0
+                };
+            }
+            displacement.set(j, c.distance(original[j]));
+            clamped_moves += usize::from(clamped);
+            moves.push(Move {
+                iteration: iterations,
+                index: j,
+                distance: c.distance(old),
+                before,
+                after: e,
+            });
+        }
+        recent.push(j);
+        history.push(HistoryRow {
+            iteration: iterations,
+            measure: e,
+            max_distance: displacement.max(),
+        });
+    }
+    let faired = curve.with_control_points(d)?;
+    let measure_after = gram.energy(faired.control_points());
+    let status = if moves.is_empty() {
+        FairStatus::NoChange
+    } else if !converged {
+        FairStatus::IterationLimit
+    } else if clamped_moves > 0 {
+        FairStatus::ToleranceLimited
+    } else {
+        FairStatus::Converged
+    };
+    let mut notes = Vec::new();
+    if clamped_moves > 0 {
+        notes.push(format!(
+            "{clamped_moves} of {} moves stopped at δ = {delta:.6e} from the original control point",
+            moves.len()
+        ));
+    }
+    let report = LocalReport {
+        status,
+        iterations,
+        accepted_moves: moves.len(),
+        clamped_moves,
+        measure_before,
+        measure_after,
+        tolerance: delta,
+        max_control_displacement: displacement.max(),
+        history,
+        moves,
+        notes,
+    };
+    Ok((faired, report))
+}
+
+/// The `eck-hadenfeld` method for point input: fit a B-spline, fair it, evaluate it at the
+/// fitted parameters.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EckHadenfeld;
+
+static PARAMS: [ParamSpec; 5] = [
+    ParamSpec {
+        name: "order",
+        default: "2",
+        doc: "derivative order l of the energy ∫|x^(l)|² dt (2 or 3)",
+    },
+    ParamSpec {
+        name: "tabu",
+        default: "4",
+        doc: "length R of the recently-moved list",
+    },
+    FIT_PARAMS[0],
+    FIT_PARAMS[1],
+    FIT_PARAMS[2],
+];
+
+impl FairMethod for EckHadenfeld {
+    fn name(&self) -> &'static str {
+        "eck-hadenfeld"
+    }
+
+    fn description(&self) -> &'static str {
+        "Eck & Hadenfeld local energy fairing: each B-spline control point in turn to the \
+         closed-form minimiser of ∫|x^(l)|² dt, within δ of the original"
+    }
+
+    fn parameters(&self) -> &'static [ParamSpec] {
+        &PARAMS
+    }
+
+    fn supports_closed(&self) -> bool {
+        false
+    }
+
+    fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
+        let fitted = local::fit_input(input, options)?;
+        let params = EckHadenfeldParams {
+            order: options.param_usize_in("order", DEFAULT_ORDER, 2, 3)?,
+            tolerance: Some(fitted.delta),
+            tabu_length: options.param_usize_in("tabu", DEFAULT_TABU_LENGTH, 0, 1000)?,
+            max_iterations: options.iterations_or(DEFAULT_MAX_ITERATIONS),
+            min_rel_decrease: DEFAULT_MIN_REL_DECREASE,
+            free_ends: fitted.free_ends,
+        };
+        let (faired, report) = fair_curve(&fitted.curve, &params)?;
+        let points = local::output_points(&faired, &fitted, input, options.fix_ends);
+        let mut parameters = fitted.parameters.clone();
+        parameters.insert("order".into(), Value::from(params.order));
+        parameters.insert("tabu".into(), params.tabu_length.into());
+        parameters.insert("max_iterations".into(), params.max_iterations.into());
+        insert_common(&mut parameters, &report);
+        let mut notes = fitted.notes;
+        notes.extend(report.notes);
+        Ok(Outcome {
+            points,
+            status: report.status,
+            iterations: report.iterations,
+            moves: report.moves,
+            history: report.history,
+            parameters,
+            notes,
+            curve: Some(faired),
+            tangents: None,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::curve::CurveDeriv;
+    use crate::spline::KnotVector;
+
+    fn curve(weights: Option<Vec<f64>>) -> BSplineCurve {
+        let pts = vec![
+            Point::new(0.0, 0.0),
+            Point::new(1.0, 1.2),
+            Point::new(2.2, 1.9),
+            Point::new(3.5, 2.0),
+            Point::new(4.6, 1.4),
+            Point::new(5.5, 0.9),
+            Point::new(6.8, 1.1),
+            Point::new(8.0, 2.0),
+        ];
+        let k = KnotVector::new(vec![
+            0.0, 0.0, 0.0, 0.0, 0.2, 0.3, 0.6, 0.8, 1.0, 1.0, 1.0, 1.0,
+        ]);
+        BSplineCurve::new(3, k, pts, weights)
+    }
+
+    /// ∫|x^(l)|² dt by brute-force quadrature on the curve's own derivatives.
+    fn brute_energy(c: &BSplineCurve, l: usize) -> f64 {
+        let gl = GaussLegendre::new(24);
+        let u = c.knots().as_slice();
+        let mut e = 0.0;
+        for s in 3..c.control_points().len() {
+            if u[s] < u[s + 1] {
+                e += gl.integrate(u[s], u[s + 1], |t| {
+                    let d = c.derivatives(t);
+                    let v = if l == 2 { d.d2 } else { d.d3 };
+                    v.length_squared()
+                });
+            }
+        }
+        e
+    }
+
+    #[test]
+    fn gram_energy_matches_quadrature() {
+        for l in [2, 3] {
+            let c = curve(None);
+            let e = energy(&c, l).expect("energy");
+            let b = brute_energy(&c, l);
+            assert!((e - b).abs() < 1e-11 * b, "l={l}: {e} vs {b}");
+            let c = curve(Some(vec![1.0, 0.8, 1.5, 1.0, 0.7, 1.2, 1.0, 1.0]));
+            let e = energy(&c, l).expect("energy");
+            let b = brute_energy(&c, l);
+            assert!((e - b).abs() < 1e-6 * b, "rational l={l}: {e} vs {b}");
+        }
+        assert!(energy(&curve(None), 4).is_err());
+    }
+
+    #[test]
+    fn closed_form_move_is_the_local_minimum() {
+        let c = curve(None);
+        let g = Gram::new(&c, 2).expect("gram");
+        let d = c.control_points().to_vec();
+        let j = 3;
+        let star = (g.coupling(&d, j) * (-1.0 / g.get(j, j))).to_point();
+        let e_at = |q: Point| {
+            let mut dd = d.clone();
+            dd[j] = q;
+            g.energy(&dd)
+        };
+        let e0 = e_at(star);
+        for v in [
+            Vec2::new(1e-3, 0.0),
+            Vec2::new(0.0, -1e-3),
+            Vec2::new(7e-4, 7e-4),
+        ] {
+            let e1 = e_at(star + v);
+            // Isotropic: E(d* + v) − E(d*) = G_jj |v|².
+            assert!((e1 - e0 - g.get(j, j) * v.length_squared()).abs() < 1e-9 * e0.max(1.0));
+        }
+    }
+}
