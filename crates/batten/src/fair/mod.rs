@@ -13,10 +13,12 @@
 pub mod cali;
 pub mod eck_hadenfeld;
 pub mod han;
+pub mod kjellander;
 pub mod local;
 mod options;
 mod report;
 pub mod salvi;
+pub mod sapidis_farin;
 pub mod smoothing;
 
 use std::time::Instant;
@@ -24,9 +26,13 @@ use std::time::Instant;
 pub use cali::Cali;
 pub use eck_hadenfeld::EckHadenfeld;
 pub use han::Han;
+pub use kjellander::{
+    Energy, HermiteMove, Kjellander, KpRule, Poliakoff, fair_hermite, hermite_step,
+};
 pub use options::{FairOptions, ParamSpec};
 pub use report::{FairReport, FairStatus, HistoryRow, Move};
 pub use salvi::Salvi;
+pub use sapidis_farin::{SapidisFarin, remove_reinsert_knot};
 pub use smoothing::{Mst, Smoothing, SmoothingInfo, SmoothingSpline, SmoothingTrial};
 
 use crate::analysis::{FairnessMetrics, displacement};
@@ -92,8 +98,22 @@ static CALI: Cali = Cali;
 static HAN: Han = Han;
 static SALVI: Salvi = Salvi;
 static ECK_HADENFELD: EckHadenfeld = EckHadenfeld;
+static KJELLANDER: Kjellander = Kjellander;
+static POLIAKOFF: Poliakoff = Poliakoff;
+static ENERGY: Energy = Energy;
+static SAPIDIS_FARIN: SapidisFarin = SapidisFarin;
 
-static REGISTRY: &[&dyn FairMethod] = &[&MST, &HAN, &CALI, &SALVI, &ECK_HADENFELD];
+static REGISTRY: &[&dyn FairMethod] = &[
+    &MST,
+    &HAN,
+    &CALI,
+    &SALVI,
+    &ECK_HADENFELD,
+    &KJELLANDER,
+    &POLIAKOFF,
+    &ENERGY,
+    &SAPIDIS_FARIN,
+];
 
 /// Every registered method, the default first.
 pub fn methods() -> &'static [&'static dyn FairMethod] {
