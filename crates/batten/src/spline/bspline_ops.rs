@@ -267,8 +267,26 @@ impl BSplineCurve {
         Ok((r, value, s))
     }
 
-    /// Remove one copy of the interior knot `knot` unconditionally, placing the error as
-    /// `rule` says, and report the largest deviation this causes.
+    /// Remove exactly one copy of the interior knot `knot`, whatever the deviation, placing
+    /// the error as `rule` says, and report the largest deviation this causes. The fairing
+    /// step of Sapidis and Farin is [`KnotRemoval::reinserted`] with [`RemovalRule::Middle`]:
+    /// the input with one control point moved so that the curve is `C^p` at the knot.
+    ///
+    /// ```
+    /// use batten::spline::{BSplineCurve, KnotRef, KnotVector, RemovalRule};
+    /// use batten::Point;
+    ///
+    /// let pts = (0..7).map(|i| Point::new(i as f64, (i % 2) as f64)).collect();
+    /// let knots = KnotVector::new(vec![0., 0., 0., 0., 0.25, 0.5, 0.75, 1., 1., 1., 1.]);
+    /// let c = BSplineCurve::new(3, knots, pts, None);
+    /// let step = c.remove_knot_exact(KnotRef::Value(0.5), RemovalRule::Middle).unwrap();
+    /// assert_eq!(step.changed, vec![3]); // the control point under the knot
+    /// assert_eq!(step.curve.control_points().len(), 6);
+    /// // Only that control point differs, and the curve moved by the reported amount.
+    /// let same = |i: usize| step.reinserted.control_points()[i] == c.control_points()[i];
+    /// assert!((0..7).all(|i| i == 3 || same(i)));
+    /// assert!(step.max_deviation > 0.5 && step.max_deviation < 1.5);
+    /// ```
     ///
     /// A knot of multiplicity `p + 1` (where the curve may be discontinuous) is removed by
     /// merging the two control points at the break: `Left` keeps the left one, `Right` the
