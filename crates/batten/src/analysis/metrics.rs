@@ -2,12 +2,11 @@
 
 use serde::Serialize;
 
-use super::ArcLengthTable;
-use super::curvature::{curvature_derivative, signed_curvature, strain_energy, variation_energy};
+use super::curvature::{curvature_derivative, signed_curvature};
 use super::gfi::{fairness_indicators, lfi_from_samples};
-use crate::curve::CurveDeriv;
 use crate::error::{Error, Result};
 use crate::geom::{Point, PointSeq};
+use crate::numeric::GaussLegendre;
 use crate::spline::{BSplineCurve, EndCondition, ParametricCubic, Parametrization};
 
 /// Relative zero for sign tests (spec §1.7.0): `sgn0(v) = 0` when `|v| ≤ ZERO_REL·max|v_k|`.
@@ -129,14 +128,19 @@ impl FairnessMetrics {
         let m = curve.num_spans();
         let t = curve.knots();
 
-        // Inflections: curvature at the knots and at the vertex of each span's quadratic.
+        // One pass over the spans, evaluating each span's polynomial directly (no span search):
+        // inflections from the curvature at the knots and at the vertex of each span's
+        // quadratic `r'×r''`; extrema and max |κ| from dense samples with both one-sided limits
+        // at the knots; length and energies by Gauss–Legendre quadrature.
+        let gl = GaussLegendre::default();
         let mut kappa_seq = Vec::with_capacity(2 * m + 1);
-        let mut dk_seq = Vec::with_capacity(SAMPLES_PER_SPAN * m + 2);
-        let mut max_curvature = 0.0_f64;
+        let mut dk_seq = Vec::with_capacity((SAMPLES_PER_SPAN + 1) * m);
+        let mut s_knots = Vec::with_capacity(m + 1);
+        let (mut max_curvature, mut length, mut strain, mut variation) = (0.0_f64, 0.0, 0.0, 0.0);
         for i in 0..m {
             let [_, a1, a2, a3] = curve.span_coeffs(i);
             let h = t[i + 1] - t[i];
-            let d0 = curve.derivatives(t[i]);
+            let d0 = curve.derivatives_in_span(i, t[i]);
             kappa_seq.push(signed_curvature(&d0));
             // cross(s) = 6(a2×a3) s² + 6(a1×a3) s + 2(a1×a2)
             let qa = 6.0 * a2.cross(a3);
@@ -144,23 +148,32 @@ impl FairnessMetrics {
             if qa != 0.0 {
                 let sv = -qb / (2.0 * qa);
                 if sv > 0.0 && sv < h {
-                    kappa_seq.push(signed_curvature(&curve.derivatives(t[i] + sv)));
+                    kappa_seq.push(signed_curvature(&curve.derivatives_in_span(i, t[i] + sv)));
                 }
             }
-            // Extrema and max |κ|: dense samples, both one-sided limits at the knots.
             for j in 0..=SAMPLES_PER_SPAN {
                 let tt = t[i] + h * j as f64 / SAMPLES_PER_SPAN as f64;
-                let d = if j == SAMPLES_PER_SPAN {
-                    curve.derivatives_left(tt)
-                } else {
-                    curve.derivatives(tt)
-                };
+                let d = curve.derivatives_in_span(i, tt);
                 max_curvature = max_curvature.max(signed_curvature(&d).abs());
                 dk_seq.push(curvature_derivative(&d));
             }
+            s_knots.push(length);
+            let half = 0.5 * h;
+            let mid = t[i] + half;
+            for (x, w) in gl.nodes().iter().zip(gl.weights()) {
+                let d = curve.derivatives_in_span(i, mid + half * x);
+                let speed = d.d1.length();
+                let k = signed_curvature(&d);
+                let dk = curvature_derivative(&d);
+                let ws = w * half * speed;
+                length += ws;
+                strain += ws * k * k;
+                variation += ws * dk * dk;
+            }
         }
+        s_knots.push(length);
         if !closed {
-            kappa_seq.push(signed_curvature(&curve.derivatives_left(t[m])));
+            kappa_seq.push(signed_curvature(&curve.derivatives_in_span(m - 1, t[m])));
         }
         // Rounding-noise floors of κ and dκ/ds (see NOISE_FACTOR).
         let pts = seq.points();
@@ -182,11 +195,11 @@ impl FairnessMetrics {
         let jumps: Vec<f64> = knots
             .iter()
             .map(|&k| {
-                let right = curve.derivatives(t[k]);
+                let right = curve.derivatives_in_span(k, t[k]);
                 let left = if k == 0 {
-                    curve.derivatives_left(t[m])
+                    curve.derivatives_in_span(m - 1, t[m])
                 } else {
-                    curve.derivatives_left(t[k])
+                    curve.derivatives_in_span(k - 1, t[k])
                 };
                 curvature_derivative(&right) - curvature_derivative(&left)
             })
@@ -198,13 +211,10 @@ impl FairnessMetrics {
             .fold(0.0_f64, |a, j| a.max(j.length()));
 
         let gfi = if closed {
-            let table = ArcLengthTable::new(&curve);
-            let kappa: Vec<f64> = t[..m]
-                .iter()
-                .map(|&x| signed_curvature(&curve.derivatives(x)))
+            let kappa: Vec<f64> = (0..m)
+                .map(|k| signed_curvature(&curve.derivatives_in_span(k, t[k])))
                 .collect();
-            let s: Vec<f64> = t[..m].iter().map(|&x| table.s_at(&curve, x)).collect();
-            lfi_from_samples(&kappa, &s, Some(table.total()))
+            lfi_from_samples(&kappa, &s_knots[..m], Some(length))
                 .iter()
                 .sum()
         } else {
@@ -218,12 +228,12 @@ impl FairnessMetrics {
             inflections,
             vibrations,
             curvature_extrema,
-            strain_energy: strain_energy(&curve),
-            variation_energy: variation_energy(&curve),
+            strain_energy: strain,
+            variation_energy: variation,
             max_curvature,
             gfi,
             max_third_derivative_jump,
-            length: super::arc_length(&curve),
+            length,
         })
     }
 }

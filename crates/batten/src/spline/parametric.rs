@@ -310,7 +310,10 @@ impl ParametricCubic {
         }
     }
 
-    fn derivs_in_span(&self, i: usize, t: f64) -> Derivatives {
+    /// Position and derivatives at `t` evaluated on span `i` (no span search; `t` may lie
+    /// outside the span, giving the span polynomial's extension). For loops that walk the
+    /// spans in order.
+    pub fn derivatives_in_span(&self, i: usize, t: f64) -> Derivatives {
         let [a0, a1, a2, a3] = self.coeffs[i];
         let s = t - self.t[i];
         let p = a0 + (a1 + (a2 + a3 * s) * s) * s;
@@ -362,7 +365,7 @@ impl Curve for ParametricCubic {
 
 impl CurveDeriv for ParametricCubic {
     fn derivatives(&self, t: f64) -> Derivatives {
-        self.derivs_in_span(self.find_span(t), t)
+        self.derivatives_in_span(self.find_span(t), t)
     }
 
     fn derivatives_left(&self, t: f64) -> Derivatives {
@@ -370,7 +373,7 @@ impl CurveDeriv for ParametricCubic {
         if i > 0 && self.t[i] == t {
             i -= 1;
         }
-        self.derivs_in_span(i, t)
+        self.derivatives_in_span(i, t)
     }
 }
 
