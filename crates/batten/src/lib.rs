@@ -11,7 +11,8 @@
 //! - [`spline`]: spline representations and their constructors;
 //! - [`analysis`]: curvature, arc length, inflections, energies, [`FairnessMetrics`];
 //! - [`fair`]: the fairing methods behind one interface ([`fair::fair`]);
-//! - [`io`]: point lists and curves in CSV and JSON.
+//! - [`io`]: point lists and curves in CSV and JSON;
+//! - `plot`: SVG pictures of curves, curvature combs and curvature graphs (feature `plot`).
 //!
 //! ```
 //! use batten::{fair, FairOptions, Point, PointSeq};
@@ -38,6 +39,8 @@ pub mod fair;
 pub mod geom;
 pub mod io;
 pub mod numeric;
+#[cfg(feature = "plot")]
+pub mod plot;
 pub mod spline;
 
 pub use analysis::FairnessMetrics;
