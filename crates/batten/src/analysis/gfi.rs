@@ -74,7 +74,10 @@ pub(crate) fn arc_lengths_at_sorted(curve: &BSplineCurve, ts: &[f64]) -> Vec<f64
             if end <= pos {
                 break;
             }
-            s += gl.integrate(pos, end, |x| curve.derivatives(x).d1.length());
+            s += gl.integrate(pos, end, |x| {
+                let d = curve.first_derivative(x);
+                d.length_squared().sqrt()
+            });
             pos = end;
         }
         out.push(s);
@@ -83,8 +86,8 @@ pub(crate) fn arc_lengths_at_sorted(curve: &BSplineCurve, ts: &[f64]) -> Vec<f64
 }
 
 /// Gauss–Legendre nodes per piece in [`arc_lengths_at_sorted`]: the speed of a spline span is
-/// smooth, and 12 nodes integrate it to rounding level on the pieces between Greville points.
-const ARC_NODES: usize = 12;
+/// smooth, and 8 nodes integrate it to rounding level on the pieces between Greville points.
+const ARC_NODES: usize = 8;
 
 /// `LFI_i = (κ''_i)²` from curvature samples `kappa` at arc lengths `s` (increasing). With
 /// `period = Some(L)` the samples are cyclic (a closed curve of length L) and every sample gets

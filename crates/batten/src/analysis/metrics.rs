@@ -162,7 +162,7 @@ impl FairnessMetrics {
             let mid = t[i] + half;
             for (x, w) in gl.nodes().iter().zip(gl.weights()) {
                 let d = curve.derivatives_in_span(i, mid + half * x);
-                let speed = d.d1.length();
+                let speed = d.d1.length_squared().sqrt();
                 let k = signed_curvature(&d);
                 let dk = curvature_derivative(&d);
                 let ws = w * half * speed;

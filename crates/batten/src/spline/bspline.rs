@@ -201,8 +201,24 @@ impl BSplineCurve {
         basis_derivs(self.knots.as_slice(), self.degree, k, t, nd.min(3), out);
     }
 
-    /// Position and up to three derivatives, from the span containing `t` (or the one
-    /// ending at `t` when `left` is true and `t` is a knot).
+    /// The first derivative `x'(t)` alone: cheaper than [`CurveDeriv::derivatives`] for arc
+    /// length (basis derivatives of order one only; rational curves take the full path).
+    pub fn first_derivative(&self, t: f64) -> Vec2 {
+        if self.weights.is_some() {
+            return self.derivatives(t).d1;
+        }
+        let p = self.degree;
+        let k = self.find_span(t);
+        let mut b = [[0.0; MAX_ORDER]; 4];
+        basis_derivs(self.knots.as_slice(), p, k, t, 1, &mut b);
+        let mut d = Vec2::ZERO;
+        for (j, c) in self.control_points[k - p..=k].iter().enumerate() {
+            d += c.to_vec2() * b[1][j];
+        }
+        d
+    }
+
+    /// Position and up to three derivatives, evaluated on span `k`.
     fn derivs_in_span(&self, k: usize, t: f64) -> Derivatives {
         let p = self.degree;
         let mut b = [[0.0; MAX_ORDER]; 4];
