@@ -12,7 +12,7 @@ use std::process::ExitCode;
 use anyhow::anyhow;
 use batten::fair::{self, FairMethod, FairReport};
 use batten::io::format_f64;
-use batten::{FairOptions, FairnessMetrics, PointSeq};
+use batten::{FairOptions, FairnessMetrics, Point, PointSeq};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -29,7 +29,7 @@ const DIGITS: usize = 4;
 
 /// How one method's run ended.
 #[derive(Debug)]
-enum Outcome {
+pub(crate) enum Outcome {
     Ran(Box<FairReport>),
     Failed(String),
     /// Not run, and why (e.g. a closed curve for a method that takes only open ones).
@@ -38,13 +38,15 @@ enum Outcome {
 
 /// One row of the table.
 #[derive(Debug)]
-struct Row {
-    method: &'static str,
+pub(crate) struct Row {
+    pub(crate) method: &'static str,
     /// The tolerance the method ran with.
     tolerance: Option<f64>,
     /// Why the options differ from the ones given, if they do.
     note: Option<String>,
-    outcome: Outcome,
+    pub(crate) outcome: Outcome,
+    /// The faired points, when the method ran (`batten report` draws them).
+    pub(crate) points: Option<Vec<Point>>,
 }
 
 /// Run `batten compare`.
@@ -88,7 +90,7 @@ pub fn run(args: &CompareArgs) -> Result<ExitCode, Failure> {
 }
 
 /// The methods named (all registered when none), each once.
-fn resolve(names: &[String]) -> Result<Vec<&'static dyn FairMethod>, Failure> {
+pub(crate) fn resolve(names: &[String]) -> Result<Vec<&'static dyn FairMethod>, Failure> {
     if names.is_empty() {
         return Ok(fair::methods().to_vec());
     }
@@ -107,7 +109,7 @@ fn resolve(names: &[String]) -> Result<Vec<&'static dyn FairMethod>, Failure> {
 }
 
 /// Run every method (in parallel), `mst` at the first method's displacement.
-fn run_methods(
+pub(crate) fn run_methods(
     methods: &[&'static dyn FairMethod],
     seq: &PointSeq,
     base: &FairOptions,
@@ -166,11 +168,15 @@ fn run_one(
     options: FairOptions,
     note: Option<String>,
 ) -> Row {
+    let mut points = None;
     let outcome = if seq.is_closed() && !m.supports_closed() {
         Outcome::Skipped("does not support closed curves".to_string())
     } else {
         match fair::fair_with(m, seq, &options) {
-            Ok(f) => Outcome::Ran(Box::new(f.report)),
+            Ok(f) => {
+                points = Some(f.points);
+                Outcome::Ran(Box::new(f.report))
+            }
             Err(e) => Outcome::Failed(e.to_string()),
         }
     };
@@ -179,6 +185,7 @@ fn run_one(
         tolerance: options.tolerance,
         note,
         outcome,
+        points,
     }
 }
 
@@ -197,7 +204,7 @@ fn remarks(row: &Row) -> Vec<String> {
     v
 }
 
-fn markdown(
+pub(crate) fn markdown(
     name: &str,
     seq: &PointSeq,
     base: &FairOptions,

@@ -17,6 +17,8 @@ mod fair_cmd;
 mod input;
 mod methods;
 mod output;
+mod plot;
+mod report;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -46,6 +48,10 @@ enum Command {
     Methods,
     /// Run several methods on the same input and tabulate the results (Han et al.'s Table 1)
     Compare(CompareArgs),
+    /// Draw the curvature comb, κ(s), ρ(s) or x–c plot as SVG, the faired curve over the input
+    Plot(plot::PlotArgs),
+    /// Run several methods and write one HTML page: metrics, the comparison table, combs, κ(s)
+    Report(report::ReportArgs),
 }
 
 /// Arguments of `batten analyze`.
@@ -137,6 +143,8 @@ fn main() -> ExitCode {
         Command::Fair(a) => fair_cmd::run(&a),
         Command::Methods => methods::run(),
         Command::Compare(a) => compare::run(&a),
+        Command::Plot(a) => plot::run(&a),
+        Command::Report(a) => report::run(&a),
     };
     match result {
         Ok(code) => code,

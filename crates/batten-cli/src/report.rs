@@ -1,0 +1,352 @@
+//! `batten report`: run several methods on one input and write one self-contained HTML page:
+//! the input's metrics and plots, the table of `batten compare`, and for every method the
+//! faired curve's comb and κ(s) drawn over the input's.
+//!
+//! The methods are run by [`crate::compare`] (the same runs, options and table as
+//! `batten compare`); the page has inline SVG and CSS only: no scripts, fonts or other
+//! resources to fetch.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use batten::io::{self, format_f64};
+use batten::plot::{PlotKind, PlotOptions, auto_comb_scale, render};
+use batten::{FairOptions, FairnessMetrics, PointSeq};
+use clap::Args;
+
+use crate::compare::{self, Outcome, Row};
+use crate::failure::{EXIT_FAILED, Failure};
+use crate::input;
+use crate::output::{self, sig};
+use crate::plot::{check_output, render_failure};
+
+/// Significant digits of the metrics table.
+const DIGITS: usize = 4;
+/// Size of each plot on the page, in pixels: two fit side by side in a 1200 px window.
+const PLOT_SIZE: (f64, f64) = (570.0, 430.0);
+
+/// Arguments of `batten report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// Point file (.csv, .txt or .json)
+    #[arg(value_name = "INPUT")]
+    input: PathBuf,
+    /// Where to write the page (.html). Never the input file
+    #[arg(short, long, value_name = "report.html")]
+    output: PathBuf,
+    /// Methods to run, comma-separated [default: all]; as in `batten compare`, mst runs at the
+    /// max displacement of the first method listed unless it is first itself
+    #[arg(long, value_delimiter = ',', value_name = "A,B,...")]
+    methods: Vec<String>,
+    /// Largest distance any point may move, in data units
+    #[arg(long, value_name = "D")]
+    tolerance: Option<f64>,
+    /// Keep the first and last points where they are
+    #[arg(long)]
+    fix_ends: bool,
+    /// The points form a closed curve
+    #[arg(long)]
+    closed: bool,
+}
+
+/// Run `batten report`.
+///
+/// # Errors
+/// Usage errors and bad input (exit 2, nothing written); a failed analysis, plot or write
+/// (exit 1). Methods that fail are reported on the page and make the exit code 1.
+pub fn run(args: &ReportArgs) -> Result<ExitCode, Failure> {
+    let methods = compare::resolve(&args.methods)?;
+    let base = input::options(args.tolerance, args.fix_ends, None, BTreeMap::new());
+    base.validate().map_err(|e| Failure::from_batten("", e))?;
+    check_output(&args.output, &["html", "htm"], &[args.input.as_path()])?;
+    let data = input::read(&args.input, args.closed)?;
+    let name = args.input.display().to_string();
+    let before = FairnessMetrics::of_seq(&data.seq)
+        .map_err(|e| Failure::from_batten(&format!("{name}: cannot analyse"), e))?;
+
+    let rows = compare::run_methods(&methods, &data.seq, &base);
+    let table = compare::markdown(&name, &data.seq, &base, &before, &rows);
+    let page = page(&name, &data.seq, &base, &before, &rows, &table)?;
+    io::write_atomic(&args.output, page.as_bytes()).map_err(Failure::failed)?;
+
+    let mut failed = false;
+    for row in &rows {
+        if let Outcome::Failed(msg) = &row.outcome {
+            output::error_line(&format!("{name}: method {} failed: {msg}", row.method));
+            failed = true;
+        }
+    }
+    Ok(if failed {
+        ExitCode::from(EXIT_FAILED)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// The page's style sheet.
+const CSS: &str = "\
+body{font-family:sans-serif;color:#222;margin:24px auto;max-width:1180px;padding:0 12px}\
+h1{font-size:24px;margin-bottom:4px}h2{font-size:19px;margin-top:32px;border-bottom:1px solid #ddd}\
+p.meta{color:#555;margin-top:0}\
+table{border-collapse:collapse;margin:8px 0}\
+th,td{border:1px solid #ccc;padding:3px 9px;font-size:14px}\
+th{background:#f3f3f3}td.r,th.r{text-align:right}td.c,th.c{text-align:center}\
+.plots{display:flex;flex-wrap:wrap;gap:10px}.plots svg{border:1px solid #ddd;max-width:100%;height:auto}\
+ol.notes{font-size:13px;color:#444}p.note{color:#8a1c10}";
+
+/// Escape text for HTML.
+fn esc(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// The HTML page.
+fn page(
+    name: &str,
+    seq: &PointSeq,
+    base: &FairOptions,
+    before: &FairnessMetrics,
+    rows: &[Row],
+    table: &str,
+) -> Result<String, Failure> {
+    // One faired point sequence per method that ran (or why there is none).
+    let faired: Vec<Result<PointSeq, String>> = rows
+        .iter()
+        .map(|row| match (&row.outcome, &row.points) {
+            (Outcome::Ran(_), Some(p)) => seq
+                .with_points(p.clone())
+                .map_err(|e| format!("the faired points cannot be drawn: {e}")),
+            (Outcome::Failed(msg), _) => Err(format!("failed: {msg}")),
+            (Outcome::Skipped(why), _) => Err(format!("skipped: {why}")),
+            (Outcome::Ran(_), None) => Err("no faired points".to_string()),
+        })
+        .collect();
+    let drawn: Vec<&PointSeq> = faired.iter().filter_map(|f| f.as_ref().ok()).collect();
+    // One comb scale for every picture, so that combs compare across methods.
+    let scale = auto_comb_scale(seq, &drawn).map_err(|e| render_failure_named(name, e))?;
+    let plot = |faired: Option<&PointSeq>, kind: PlotKind, title: String| {
+        let mut o = PlotOptions::DEFAULT
+            .with_kind(kind)
+            .with_size(PLOT_SIZE.0, PLOT_SIZE.1)
+            .with_title(title);
+        if scale > 0.0 {
+            o = o.with_comb_scale(scale);
+        }
+        render(seq, faired, &o).map_err(|e| render_failure_named(name, e))
+    };
+
+    let mut h = String::with_capacity(256 * 1024);
+    let title = format!("batten report: {name}");
+    // Writing to a String cannot fail.
+    let _ = write!(
+        h,
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
+         <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
+         <title>{}</title>\n<style>{CSS}</style>\n</head>\n<body>\n<h1>{}</h1>\n",
+        esc(&title),
+        esc(&title)
+    );
+    let _ = writeln!(
+        h,
+        "<p class=\"meta\">{} points, {}; tolerance {}{}; made by batten {}.</p>",
+        seq.len(),
+        if seq.is_closed() { "closed" } else { "open" },
+        base.tolerance
+            .map_or_else(|| "none".to_string(), format_f64),
+        if base.fix_ends { "; ends fixed" } else { "" },
+        env!("CARGO_PKG_VERSION"),
+    );
+
+    h.push_str("<h2>Input</h2>\n");
+    h.push_str(&metrics_table(before));
+    h.push_str("<div class=\"plots\">\n");
+    h.push_str(&plot(None, PlotKind::Comb, "Input: curvature comb".into())?);
+    h.push_str(&plot(
+        None,
+        PlotKind::Curvature,
+        "Input: curvature κ(s)".into(),
+    )?);
+    h.push_str("</div>\n");
+
+    h.push_str("<h2>Comparison</h2>\n");
+    h.push_str(&markdown_to_html(table));
+
+    for (row, f) in rows.iter().zip(&faired) {
+        let _ = writeln!(h, "<h2>{}</h2>", esc(row.method));
+        match f {
+            Ok(f) => {
+                h.push_str(
+                    "<p>The faired curve (red) over the input (blue); every comb on this page \
+                     has the same scale.</p>\n<div class=\"plots\">\n",
+                );
+                h.push_str(&plot(
+                    Some(f),
+                    PlotKind::Comb,
+                    format!("{}: curvature comb", row.method),
+                )?);
+                h.push_str(&plot(
+                    Some(f),
+                    PlotKind::Curvature,
+                    format!("{}: curvature κ(s)", row.method),
+                )?);
+                h.push_str("</div>\n");
+            }
+            Err(why) => {
+                let _ = writeln!(h, "<p class=\"note\">{}</p>", esc(why));
+            }
+        }
+    }
+    h.push_str("</body>\n</html>\n");
+    Ok(h)
+}
+
+fn render_failure_named(name: &str, e: batten::Error) -> Failure {
+    render_failure(std::path::Path::new(name), e)
+}
+
+/// The input's metrics as a two-column table.
+fn metrics_table(m: &FairnessMetrics) -> String {
+    let rows: [(&str, String); 11] = [
+        ("points", m.points.to_string()),
+        ("closed", if m.closed { "yes" } else { "no" }.to_string()),
+        ("length", sig(m.length, DIGITS)),
+        ("inflections", m.inflections.to_string()),
+        ("curvature vibrations", m.vibrations.to_string()),
+        ("curvature extrema", m.curvature_extrema.to_string()),
+        ("max |κ|", sig(m.max_curvature, DIGITS)),
+        ("strain energy ∫κ² ds", sig(m.strain_energy, DIGITS)),
+        (
+            "variation energy ∫(dκ/ds)² ds",
+            sig(m.variation_energy, DIGITS),
+        ),
+        ("GFI (Calì)", sig(m.gfi, DIGITS)),
+        ("max jump of r‴", sig(m.max_third_derivative_jump, DIGITS)),
+    ];
+    let mut s = String::from("<table class=\"metrics\">\n<tr><th>metric</th><th>value</th></tr>\n");
+    for (k, v) in rows {
+        // Writing to a String cannot fail.
+        let _ = writeln!(
+            s,
+            "<tr><td>{}</td><td class=\"r\">{}</td></tr>",
+            esc(k),
+            esc(&v)
+        );
+    }
+    s.push_str("</table>\n");
+    s
+}
+
+/// The Markdown that `batten compare` prints (a caption line, a pipe table, numbered notes)
+/// as HTML: the caption and notes as paragraphs, the table as a `<table>` with the column
+/// alignment of its delimiter row.
+fn markdown_to_html(md: &str) -> String {
+    let cells = |line: &str| -> Vec<String> {
+        let inner = line.trim().trim_start_matches('|').trim_end_matches('|');
+        inner.split('|').map(|c| c.trim().to_string()).collect()
+    };
+    let mut out = String::new();
+    let mut table: Vec<Vec<String>> = Vec::new();
+    let mut notes: Vec<&str> = Vec::new();
+    let mut before_table = true;
+    for line in md.lines() {
+        let t = line.trim();
+        if t.starts_with('|') {
+            table.push(cells(t));
+            before_table = false;
+        } else if t.is_empty() {
+            continue;
+        } else if before_table {
+            let _ = writeln!(out, "<p>{}</p>", esc(t));
+        } else {
+            notes.push(t);
+        }
+    }
+    if table.len() >= 2 {
+        let align: Vec<&str> = table[1]
+            .iter()
+            .map(|c| match (c.starts_with(':'), c.ends_with(':')) {
+                (true, true) => "c",
+                (false, true) => "r",
+                _ => "",
+            })
+            .collect();
+        let cell = |tag: &str, i: usize, text: &str| {
+            let class = align.get(i).copied().unwrap_or("");
+            if class.is_empty() {
+                format!("<{tag}>{}</{tag}>", esc(text))
+            } else {
+                format!("<{tag} class=\"{class}\">{}</{tag}>", esc(text))
+            }
+        };
+        out.push_str("<table class=\"compare\">\n<tr>");
+        for (i, c) in table[0].iter().enumerate() {
+            out.push_str(&cell("th", i, c));
+        }
+        out.push_str("</tr>\n");
+        for row in &table[2..] {
+            out.push_str("<tr>");
+            for (i, c) in row.iter().enumerate() {
+                out.push_str(&cell("td", i, c));
+            }
+            out.push_str("</tr>\n");
+        }
+        out.push_str("</table>\n");
+    }
+    if !notes.is_empty() {
+        out.push_str("<ol class=\"notes\">\n");
+        for n in notes {
+            // "[1] mst: ..." → the list numbers it.
+            let text = n.split_once("] ").map_or(n, |(_, rest)| rest);
+            let _ = writeln!(out, "<li>{}</li>", esc(text));
+        }
+        out.push_str("</ol>\n");
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn markdown_table_becomes_html() {
+        let md = "a.csv: 4 points, open; tolerance none\n\n\
+                  | Method | Infl | time |\n| :-- | --: | --: |\n| input | 3 | – |\n\
+                  | mst [1] | 1 | 2 ms |\n\n[1] mst: run at <tolerance> 0.1\n";
+        let html = markdown_to_html(md);
+        assert!(html.starts_with("<p>a.csv: 4 points, open; tolerance none</p>\n"));
+        assert!(html.contains("<tr><th>Method</th><th class=\"r\">Infl</th>"));
+        assert!(
+            html.contains(
+                "<tr><td>mst [1]</td><td class=\"r\">1</td><td class=\"r\">2 ms</td></tr>"
+            )
+        );
+        assert!(html.contains("<li>mst: run at &lt;tolerance&gt; 0.1</li>"));
+        assert_eq!(html.matches("<tr>").count(), 3);
+    }
+
+    #[test]
+    fn escaping() {
+        assert_eq!(esc("a<b>&\"c\""), "a&lt;b&gt;&amp;&quot;c&quot;");
+    }
+
+    #[test]
+    fn drawing_errors_are_one_line_naming_the_input() {
+        let f = render_failure_named("x.csv", batten::Error::Degenerate("d".into()));
+        assert_eq!(
+            f.error.to_string(),
+            "x.csv: cannot plot: degenerate geometry: d"
+        );
+    }
+}
