@@ -266,7 +266,7 @@ pub(crate) fn markdown(
 }
 
 /// A CSV field, quoted when it must be.
-fn csv_field(text: &str) -> String {
+pub fn csv_field(text: &str) -> String {
     if text.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", text.replace('"', "\"\""))
     } else {
@@ -275,7 +275,7 @@ fn csv_field(text: &str) -> String {
 }
 
 /// A number for CSV: exact, or empty when not finite.
-fn csv_num(x: f64) -> String {
+pub fn csv_num(x: f64) -> String {
     if x.is_finite() {
         format_f64(x)
     } else {

@@ -81,7 +81,7 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
 }
 
 /// A file can only be written into a directory that exists: say so before fairing.
-fn check_directory(path: &Path) -> Result<(), Failure> {
+pub fn check_directory(path: &Path) -> Result<(), Failure> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -98,13 +98,13 @@ fn check_directory(path: &Path) -> Result<(), Failure> {
 }
 
 /// Whether two paths name the same file, as far as can be told before either exists.
-fn same_path(a: &Path, b: &Path) -> bool {
+pub fn same_path(a: &Path, b: &Path) -> bool {
     let abs = |p: &Path| -> PathBuf { std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()) };
     abs(a) == abs(b)
 }
 
 /// Write the report as pretty JSON, atomically.
-fn write_report(path: &Path, report: &FairReport) -> Result<(), Failure> {
+pub fn write_report(path: &Path, report: &FairReport) -> Result<(), Failure> {
     let mut json = serde_json::to_string_pretty(report)
         .map_err(|e| Failure::failed(anyhow!("cannot encode the report: {e}")))?;
     json.push('\n');

@@ -11,6 +11,7 @@
 //! crate needs no `allow` for the workspace's `print_stdout`/`print_stderr` lints.
 
 mod analyze;
+mod batch;
 mod compare;
 mod failure;
 mod fair_cmd;
@@ -52,6 +53,8 @@ enum Command {
     Plot(plot::PlotArgs),
     /// Run several methods and write one HTML page: metrics, the comparison table, combs, κ(s)
     Report(report::ReportArgs),
+    /// Fair many point files in parallel into OUT_DIR, with a report each and a summary
+    Batch(batch::BatchArgs),
 }
 
 /// Arguments of `batten analyze`.
@@ -145,6 +148,7 @@ fn main() -> ExitCode {
         Command::Compare(a) => compare::run(&a),
         Command::Plot(a) => plot::run(&a),
         Command::Report(a) => report::run(&a),
+        Command::Batch(a) => batch::run(&a),
     };
     match result {
         Ok(code) => code,

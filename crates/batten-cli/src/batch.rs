@@ -1,0 +1,726 @@
+//! `batten batch`: fair many point files in parallel into one output directory.
+//!
+//! Every check that does not need the curves runs first, so a usage error leaves nothing
+//! behind: the method, the options, the summary's format and directory, the input list, the
+//! output names (two inputs may not write the same file) and the output directory (never an
+//! input's directory). Then each file is read, faired and written on its own: a file that
+//! fails is a row of the summary and a line on stderr, not the end of the batch.
+//!
+//! A parameter value (`--set p=2`) is checked by the method when it runs, so it is reported
+//! per file: the library cannot check one without data, and some ranges depend on the data
+//! (`control_points` at most the number of points). A file that fails writes nothing, and
+//! does not remove what an earlier run wrote under its name: the summary tells which results
+//! are from this run.
+//!
+//! Exit codes: 0 when every file was faired within its tolerance; 2 when an input was
+//! unreadable or invalid (or on a usage error); otherwise 1 when a fairing failed, missed its
+//! tolerance, or an output could not be written.
+
+use std::collections::HashMap;
+use std::ffi::OsString;
+use std::fmt::Write as _;
+use std::fs;
+use std::io::IsTerminal as _;
+use std::num::NonZeroUsize;
+use std::panic::{self, AssertUnwindSafe};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::anyhow;
+use batten::FairOptions;
+use batten::fair::{self, FairMethod, FairReport};
+use batten::io::{self, Format, IoError, format_f64};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::compare::{csv_field, csv_num};
+use crate::failure::{EXIT_FAILED, EXIT_USAGE, Failure};
+use crate::output::{self, sig};
+use crate::{fair_cmd, input};
+
+/// Significant digits of displacements in messages.
+const DIGITS: usize = 4;
+
+/// Suffix of the report written beside each output: `NAME.csv` → `NAME.report.json`.
+const REPORT_SUFFIX: &str = ".report.json";
+
+/// Arguments of `batten batch`.
+#[derive(Debug, Args)]
+pub struct BatchArgs {
+    /// Point files, directories (their .csv, .txt and .json files, by name; not recursive), or
+    /// quoted patterns with * and ? in the file name ("hull/frame-*.csv")
+    #[arg(value_name = "INPUT", required = true)]
+    inputs: Vec<PathBuf>,
+    /// Directory for the faired points (same file names and formats) and the reports
+    /// (NAME.report.json); created if missing. Never an input's directory
+    #[arg(short, long = "output", value_name = "OUT_DIR")]
+    out_dir: PathBuf,
+    /// Fairing method (see `batten methods`) [default: the first listed there]
+    #[arg(long, value_name = "NAME")]
+    method: Option<String>,
+    /// Largest distance any point may move, in data units
+    #[arg(long, value_name = "D")]
+    tolerance: Option<f64>,
+    /// Keep the first and last points where they are
+    #[arg(long)]
+    fix_ends: bool,
+    /// Upper bound on the method's iterations (its own unit: sweeps, moves or passes)
+    #[arg(long, value_name = "N")]
+    max_iterations: Option<usize>,
+    /// A method parameter, KEY=VALUE (repeat for several; see `batten methods`)
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Write one row per input, in input order (file, status, error, points, iterations,
+    /// displacements, metrics before and after) to this .json or .csv file
+    #[arg(long, value_name = "FILE")]
+    summary: Option<PathBuf>,
+    /// Files faired at once [default: one per core; more can help where writes wait for a
+    /// slow disk, as every file is synced]
+    #[arg(long, value_name = "N")]
+    jobs: Option<NonZeroUsize>,
+}
+
+/// How one input ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+enum Status {
+    /// Faired within the tolerance; output and report written.
+    Ok,
+    /// Faired, but a point moved farther than the tolerance; output and report written.
+    ToleranceExceeded,
+    /// The method failed, or the output or report could not be written.
+    Failed,
+    /// The file could not be read, or its data or its closedness was rejected.
+    InvalidInput,
+}
+
+impl Status {
+    /// The name used in the summary.
+    fn name(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::ToleranceExceeded => "tolerance_exceeded",
+            Status::Failed => "failed",
+            Status::InvalidInput => "invalid_input",
+        }
+    }
+}
+
+/// One input: where it is read from and where its results go.
+#[derive(Debug)]
+struct Job {
+    input: PathBuf,
+    output: PathBuf,
+    report: PathBuf,
+}
+
+/// One row of the summary. Fields that are not known for a row (the metrics of a file that
+/// could not be read) are `null` in JSON and empty in CSV.
+#[derive(Debug, Serialize)]
+struct Row {
+    file: String,
+    status: Status,
+    error: Option<String>,
+    points: Option<usize>,
+    iterations: Option<usize>,
+    max_displacement: Option<f64>,
+    sum_displacement: Option<f64>,
+    tolerance_met: Option<bool>,
+    inflections_before: Option<usize>,
+    inflections_after: Option<usize>,
+    vibrations_before: Option<usize>,
+    vibrations_after: Option<usize>,
+    strain_energy_before: Option<f64>,
+    strain_energy_after: Option<f64>,
+    gfi_before: Option<f64>,
+    gfi_after: Option<f64>,
+}
+
+impl Row {
+    /// A row with the given outcome; the numbers come from the report when there is one.
+    fn new(
+        job: &Job,
+        status: Status,
+        error: Option<String>,
+        points: Option<usize>,
+        report: Option<&FairReport>,
+    ) -> Row {
+        Row {
+            file: job.input.display().to_string(),
+            status,
+            error,
+            points,
+            iterations: report.map(|r| r.iterations),
+            max_displacement: report.map(|r| r.max_displacement),
+            sum_displacement: report.map(|r| r.sum_displacement),
+            tolerance_met: report.map(|r| r.tolerance_met),
+            inflections_before: report.map(|r| r.before.inflections),
+            inflections_after: report.map(|r| r.after.inflections),
+            vibrations_before: report.map(|r| r.before.vibrations),
+            vibrations_after: report.map(|r| r.after.vibrations),
+            strain_energy_before: report.map(|r| r.before.strain_energy),
+            strain_energy_after: report.map(|r| r.after.strain_energy),
+            gfi_before: report.map(|r| r.before.gfi),
+            gfi_after: report.map(|r| r.after.gfi),
+        }
+    }
+}
+
+/// Run `batten batch`.
+///
+/// # Errors
+/// Usage errors found before any file is faired (exit 2); a failure to create the output
+/// directory or to start the worker threads (exit 1). Problems with single files are not
+/// errors: they are rows of the summary and decide the exit code.
+pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
+    let name = args
+        .method
+        .as_deref()
+        .unwrap_or_else(|| fair::default_method());
+    let method = input::method(name)?;
+    let params = input::parse_sets(&args.set)?;
+    let options = input::options(args.tolerance, args.fix_ends, args.max_iterations, params);
+    input::check(method, false, &options)?;
+    let summary_format = match &args.summary {
+        Some(path) => Some(summary_format(path)?),
+        None => None,
+    };
+
+    let inputs = expand(&args.inputs)?;
+    let jobs = plan(&inputs, &args.out_dir)?;
+    check_out_dir(&jobs, &args.out_dir)?;
+    if let Some(path) = &args.summary {
+        check_summary(path, &jobs, &args.out_dir)?;
+    }
+    fs::create_dir_all(&args.out_dir).map_err(|e| {
+        Failure::failed(anyhow!(
+            "{}: cannot create directory: {e}",
+            args.out_dir.display()
+        ))
+    })?;
+
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.jobs.map_or(0, NonZeroUsize::get))
+        .build()
+        .map_err(|e| Failure::failed(anyhow!("cannot start worker threads: {e}")))?;
+    let bar = progress_bar(jobs.len());
+    let rows: Vec<Row> = pool.install(|| {
+        jobs.par_iter()
+            .map(|job| {
+                let row = fair_one(job, method, &options);
+                bar.inc(1);
+                row
+            })
+            .collect()
+    });
+    bar.finish_and_clear();
+
+    let summary_written = match (&args.summary, summary_format) {
+        (Some(path), Some(format)) => {
+            let text = match format {
+                SummaryFormat::Json => summary_json(&rows),
+                SummaryFormat::Csv => Ok(summary_csv(&rows)),
+            };
+            text.and_then(|t| io::write_atomic(path, t.as_bytes()).map_err(|e| e.to_string()))
+        }
+        _ => Ok(()),
+    };
+    for row in &rows {
+        if let Some(message) = &row.error {
+            output::error_line(message);
+        }
+    }
+    let summary_failed = summary_written.is_err();
+    if let Err(message) = summary_written {
+        output::error_line(&message);
+    }
+    let count = |s: Status| rows.iter().filter(|r| r.status == s).count();
+    let (ok, exceeded) = (count(Status::Ok), count(Status::ToleranceExceeded));
+    let (failed, invalid) = (count(Status::Failed), count(Status::InvalidInput));
+    output::note(&format!(
+        "batch: {} files: {ok} ok, {exceeded} tolerance exceeded, {failed} failed, \
+         {invalid} invalid input; results in {}",
+        rows.len(),
+        args.out_dir.display()
+    ));
+    Ok(if invalid > 0 {
+        ExitCode::from(EXIT_USAGE)
+    } else if exceeded > 0 || failed > 0 || summary_failed {
+        ExitCode::from(EXIT_FAILED)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// A progress bar on stderr, hidden when stderr is not a terminal (tests, CI, logs).
+fn progress_bar(len: usize) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(
+        Some(u64::try_from(len).unwrap_or(u64::MAX)),
+        ProgressDrawTarget::stderr(),
+    );
+    if let Ok(style) =
+        ProgressStyle::with_template("{bar:40} {pos}/{len} files [{elapsed_precise}, eta {eta}]")
+    {
+        bar.set_style(style);
+    }
+    bar
+}
+
+/// Read, fair and write one file. Never fails: every problem becomes the row's status and
+/// error. A panic in the library is caught so that one bad curve cannot end the batch.
+fn fair_one(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> Row {
+    match panic::catch_unwind(AssertUnwindSafe(|| fair_one_inner(job, method, options))) {
+        Ok(row) => row,
+        Err(payload) => {
+            let why = payload
+                .downcast_ref::<&str>()
+                .map(|s| (*s).to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown cause".to_string());
+            let message = format!(
+                "{}: method {} failed: internal error (panic: {why})",
+                job.input.display(),
+                method.name()
+            );
+            Row::new(job, Status::Failed, Some(message), None, None)
+        }
+    }
+}
+
+fn fair_one_inner(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> Row {
+    let file = job.input.display();
+    let data = match input::read(&job.input, false) {
+        Ok(d) => d,
+        Err(f) => {
+            let message = f.error.to_string();
+            return Row::new(job, Status::InvalidInput, Some(message), None, None);
+        }
+    };
+    let points = Some(data.seq.len());
+    // A JSON file can make the curve closed: check the method against that.
+    if let Err(f) = input::check(method, data.seq.is_closed(), options) {
+        let message = format!("{file}: {}", f.error);
+        return Row::new(job, Status::InvalidInput, Some(message), points, None);
+    }
+    let faired = match fair::fair_with(method, &data.seq, options) {
+        Ok(f) => f,
+        Err(e) => {
+            let f = Failure::from_batten(&format!("{file}: method {} failed", method.name()), e);
+            let status = if f.exit_code() == ExitCode::from(EXIT_USAGE) {
+                Status::InvalidInput
+            } else {
+                Status::Failed
+            };
+            return Row::new(job, status, Some(f.error.to_string()), points, None);
+        }
+    };
+    let report = &faired.report;
+    // Tangents: the method's, else the input's carried through (as `batten fair` does).
+    let tangents = faired.tangents.as_deref().or(data.tangents.as_deref());
+    let written = io::write_points(&job.output, &faired.points, data.seq.is_closed(), tangents)
+        .map_err(|e| e.to_string())
+        .and_then(|()| {
+            fair_cmd::write_report(&job.report, report).map_err(|f| f.error.to_string())
+        });
+    let (status, error) = match written {
+        Err(message) => (Status::Failed, Some(message)),
+        Ok(()) if report.tolerance_met => (Status::Ok, None),
+        Ok(()) => (
+            Status::ToleranceExceeded,
+            Some(format!(
+                "{file}: tolerance {} not met: a point moved {}; output and report written anyway",
+                report.tolerance.map_or_else(String::new, format_f64),
+                sig(report.max_displacement, DIGITS),
+            )),
+        ),
+    };
+    Row::new(job, status, error, points, Some(report))
+}
+
+/// The summary's format, from its extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum SummaryFormat {
+    Json,
+    Csv,
+}
+
+fn summary_format(path: &Path) -> Result<SummaryFormat, Failure> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("json") => Ok(SummaryFormat::Json),
+        Some("csv") => Ok(SummaryFormat::Csv),
+        _ => Err(Failure::usage(anyhow!(
+            "{}: unknown summary format (use a .json or .csv file name)",
+            path.display()
+        ))),
+    }
+}
+
+/// The inputs as listed: files as given, directories expanded to their point files sorted by
+/// name, patterns to the point files they match sorted by name.
+///
+/// # Errors
+/// [`Failure::usage`] for a directory that cannot be listed, a pattern that matches nothing,
+/// or no input file at all.
+fn expand(args: &[PathBuf]) -> Result<Vec<PathBuf>, Failure> {
+    let mut inputs = Vec::new();
+    for arg in args {
+        if arg.is_dir() {
+            inputs.extend(list_dir(arg, None)?);
+        } else if let Some(pattern) = pattern(arg) {
+            let dir = arg.parent().unwrap_or(Path::new(""));
+            let found = list_dir(dir, Some(pattern))?;
+            if found.is_empty() {
+                return Err(Failure::usage(anyhow!(
+                    "{}: matches no .csv, .txt or .json file",
+                    arg.display()
+                )));
+            }
+            inputs.extend(found);
+        } else {
+            // A file, or a path that does not exist: reading it reports what is wrong.
+            inputs.push(arg.clone());
+        }
+    }
+    if inputs.is_empty() {
+        return Err(Failure::usage(anyhow!(
+            "no .csv, .txt or .json files in {}",
+            args.iter()
+                .map(|a| a.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    }
+    Ok(inputs)
+}
+
+/// The file-name pattern of `path`, when it names no existing file and its last component
+/// holds `*` or `?`.
+fn pattern(path: &Path) -> Option<&str> {
+    if path.exists() {
+        return None;
+    }
+    let name = path.file_name()?.to_str()?;
+    name.contains(['*', '?']).then_some(name)
+}
+
+/// The point files (known extension, not hidden, regular files or links to them) of `dir`
+/// whose names match `pattern` (all, without one), sorted by name.
+fn list_dir(dir: &Path, pattern: Option<&str>) -> Result<Vec<PathBuf>, Failure> {
+    let read_from = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    let cannot = |e: std::io::Error| {
+        Failure::usage(anyhow!(
+            "{}: cannot read directory: {e}",
+            read_from.display()
+        ))
+    };
+    let mut names: Vec<OsString> = Vec::new();
+    for entry in fs::read_dir(read_from).map_err(cannot)? {
+        let name = entry.map_err(cannot)?.file_name();
+        let lossy = name.to_string_lossy();
+        let shown = match pattern {
+            Some(p) => wildcard_match(p, &lossy) && (p.starts_with('.') || !lossy.starts_with('.')),
+            None => !lossy.starts_with('.'),
+        };
+        let path = dir.join(&name);
+        if shown && Format::from_path(&path).is_ok() && path.is_file() {
+            names.push(name);
+        }
+    }
+    names.sort();
+    Ok(names.into_iter().map(|n| dir.join(n)).collect())
+}
+
+/// Whether `name` matches `pattern`, where `*` matches any run of characters and `?` any one
+/// character. Greedy, backtracking to the last `*` only: O(pattern × name), never exponential.
+fn wildcard_match(pattern: &str, name: &str) -> bool {
+    let p: Vec<char> = pattern.chars().collect();
+    let n: Vec<char> = name.chars().collect();
+    let (mut pi, mut ni) = (0, 0);
+    // The last `*` seen and the name position it is currently matched up to.
+    let mut star: Option<(usize, usize)> = None;
+    while let Some(&c) = n.get(ni) {
+        match p.get(pi) {
+            Some('*') => {
+                star = Some((pi, ni));
+                pi += 1;
+            }
+            Some(&q) if q == '?' || q == c => {
+                pi += 1;
+                ni += 1;
+            }
+            _ => match star {
+                Some((sp, sn)) => {
+                    star = Some((sp, sn + 1));
+                    pi = sp + 1;
+                    ni = sn + 1;
+                }
+                None => return false,
+            },
+        }
+    }
+    p.iter().skip(pi).all(|&c| c == '*')
+}
+
+/// The output and report paths of every input.
+///
+/// # Errors
+/// [`Failure::usage`] when an input has no file name, or two inputs would write the same file
+/// (compared ignoring ASCII case, as on case-insensitive file systems): the same file given
+/// twice, `a/x.csv` and `b/x.csv`, or `x.csv` and `x.json` (both report to `x.report.json`).
+fn plan(inputs: &[PathBuf], out_dir: &Path) -> Result<Vec<Job>, Failure> {
+    let mut writers: HashMap<String, &Path> = HashMap::new();
+    let mut jobs = Vec::with_capacity(inputs.len());
+    for input in inputs {
+        let (Some(name), Some(stem)) = (input.file_name(), input.file_stem()) else {
+            return Err(Failure::usage(anyhow!(
+                "{}: not a file name",
+                input.display()
+            )));
+        };
+        let mut report = stem.to_os_string();
+        report.push(REPORT_SUFFIX);
+        for out_name in [name, report.as_os_str()] {
+            let key = out_name.to_string_lossy().to_ascii_lowercase();
+            if let Some(other) = writers.insert(key, input) {
+                let target = out_dir.join(out_name);
+                return Err(Failure::usage(if other == input.as_path() {
+                    anyhow!("{} is given more than once", input.display())
+                } else {
+                    anyhow!(
+                        "{} and {} would both write {}",
+                        other.display(),
+                        input.display(),
+                        target.display()
+                    )
+                }));
+            }
+        }
+        jobs.push(Job {
+            input: input.clone(),
+            output: out_dir.join(name),
+            report: out_dir.join(report),
+        });
+    }
+    Ok(jobs)
+}
+
+/// Refuse an output directory that is not a directory, or that holds an input (by the path
+/// given or, through links, by the file's real place), so that no input is ever replaced.
+fn check_out_dir(jobs: &[Job], out_dir: &Path) -> Result<(), Failure> {
+    if !out_dir.exists() {
+        return Ok(());
+    }
+    if !out_dir.is_dir() {
+        return Err(Failure::usage(anyhow!(
+            "{}: not a directory",
+            out_dir.display()
+        )));
+    }
+    let Ok(out_real) = fs::canonicalize(out_dir) else {
+        return Ok(());
+    };
+    let mut parents: HashMap<PathBuf, Option<PathBuf>> = HashMap::new();
+    for job in jobs {
+        let parent = match job.input.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        let given = parents
+            .entry(parent.to_path_buf())
+            .or_insert_with(|| fs::canonicalize(parent).ok());
+        let real = fs::canonicalize(&job.input).ok();
+        let real_parent = real.as_deref().and_then(Path::parent);
+        if given.as_deref() == Some(out_real.as_path()) || real_parent == Some(out_real.as_path()) {
+            return Err(Failure::usage(anyhow!(
+                "refusing to write into {}: it is the directory of the input {}",
+                out_dir.display(),
+                job.input.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The summary goes into an existing directory or the output directory, and replaces neither
+/// an input nor an output of the batch.
+fn check_summary(path: &Path, jobs: &[Job], out_dir: &Path) -> Result<(), Failure> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let in_out_dir = fair_cmd::same_path(dir, out_dir)
+        || matches!(
+            (fs::canonicalize(dir), fs::canonicalize(out_dir)),
+            (Ok(a), Ok(b)) if a == b
+        );
+    if path.is_dir() {
+        return Err(Failure::usage(anyhow!(
+            "--summary {}: is a directory",
+            path.display()
+        )));
+    }
+    if !in_out_dir {
+        fair_cmd::check_directory(path)?;
+    }
+    if let Ok(real) = fs::canonicalize(path) {
+        for job in jobs {
+            if fs::canonicalize(&job.input).is_ok_and(|i| i == real) {
+                return Err(Failure::usage(IoError::SameFile {
+                    input: job.input.clone(),
+                    output: path.to_path_buf(),
+                }));
+            }
+        }
+    }
+    if in_out_dir && let Some(name) = path.file_name() {
+        let key = name.to_string_lossy().to_ascii_lowercase();
+        let clash = jobs.iter().find(|j| {
+            [&j.output, &j.report].iter().any(|p| {
+                p.file_name()
+                    .is_some_and(|n| n.to_string_lossy().to_ascii_lowercase() == key)
+            })
+        });
+        if let Some(job) = clash {
+            return Err(Failure::usage(anyhow!(
+                "--summary {} would replace a result of {}",
+                path.display(),
+                job.input.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The summary as a pretty JSON array, one object per row, keys in [`Row`]'s order.
+fn summary_json(rows: &[Row]) -> Result<String, String> {
+    let mut json = serde_json::to_string_pretty(rows)
+        .map_err(|e| format!("cannot encode the summary: {e}"))?;
+    json.push('\n');
+    Ok(json)
+}
+
+/// The summary as CSV with a header row; unknown and non-finite numbers are empty cells.
+fn summary_csv(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "file,status,error,points,iterations,max_displacement,sum_displacement,tolerance_met,\
+         inflections_before,inflections_after,vibrations_before,vibrations_after,\
+         strain_energy_before,strain_energy_after,gfi_before,gfi_after\n",
+    );
+    let int = |n: Option<usize>| n.map(|n| n.to_string()).unwrap_or_default();
+    let num = |x: Option<f64>| x.map(csv_num).unwrap_or_default();
+    for r in rows {
+        // Writing to a String cannot fail.
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            csv_field(&r.file),
+            r.status.name(),
+            csv_field(r.error.as_deref().unwrap_or_default()),
+            int(r.points),
+            int(r.iterations),
+            num(r.max_displacement),
+            num(r.sum_displacement),
+            r.tolerance_met.map(|b| b.to_string()).unwrap_or_default(),
+            int(r.inflections_before),
+            int(r.inflections_after),
+            int(r.vibrations_before),
+            int(r.vibrations_after),
+            num(r.strain_energy_before),
+            num(r.strain_energy_after),
+            num(r.gfi_before),
+            num(r.gfi_after),
+        );
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wildcards() {
+        for (p, n) in [
+            ("*.csv", "a.csv"),
+            ("*.csv", ".csv"),
+            ("frame-??.csv", "frame-07.csv"),
+            ("*", ""),
+            ("a*b*c", "aXbYbZc"),
+            ("**x", "x"),
+            ("é?.json", "éz.json"),
+        ] {
+            assert!(wildcard_match(p, n), "{p} should match {n}");
+        }
+        for (p, n) in [
+            ("*.csv", "a.csv.bak"),
+            ("frame-??.csv", "frame-7.csv"),
+            ("a*b*c", "aXbYbZ"),
+            ("?", ""),
+            ("x", "xx"),
+        ] {
+            assert!(!wildcard_match(p, n), "{p} should not match {n}");
+        }
+        // Backtracking on the last star stays linear.
+        let long = "a".repeat(10_000);
+        assert!(!wildcard_match("*a*a*a*b", &long));
+    }
+
+    #[test]
+    fn status_names_match_serde() {
+        for s in [
+            Status::Ok,
+            Status::ToleranceExceeded,
+            Status::Failed,
+            Status::InvalidInput,
+        ] {
+            assert_eq!(
+                serde_json::to_value(s)
+                    .ok()
+                    .and_then(|v| v.as_str().map(String::from)),
+                Some(s.name().to_string())
+            );
+        }
+    }
+
+    #[test]
+    fn output_names_may_not_collide() {
+        let out = Path::new("out");
+        let jobs = plan(&[PathBuf::from("a/x.csv"), PathBuf::from("b/y.json")], out);
+        let jobs = jobs.map_err(|f| f.error.to_string());
+        assert!(jobs.is_ok(), "{jobs:?}");
+        let err = |inputs: &[&str]| {
+            let v: Vec<PathBuf> = inputs.iter().map(PathBuf::from).collect();
+            plan(&v, out).err().map(|f| f.error.to_string())
+        };
+        assert_eq!(
+            err(&["a/x.csv", "b/X.CSV"]).as_deref(),
+            Some(
+                format!(
+                    "a/x.csv and b/X.CSV would both write {}",
+                    out.join("X.CSV").display()
+                )
+                .as_str()
+            )
+        );
+        assert!(err(&["x.csv", "x.json"]).is_some_and(|e| e.ends_with("x.report.json")));
+        assert!(err(&["x.csv", "x.report.json"]).is_some());
+        assert_eq!(
+            err(&["d/x.csv", "d/x.csv"]).as_deref(),
+            Some("d/x.csv is given more than once")
+        );
+        assert_eq!(err(&[".."]).as_deref(), Some("..: not a file name"));
+    }
+}
