@@ -114,7 +114,7 @@ pub(crate) fn comb(svg: &mut Svg, outer: Rect, series: &[&Sampled], scale: f64, 
         ));
     }
     legend.push(LegendItem::new(
-        Swatch::Line(TEETH[0]),
+        Swatch::Line(ENVELOPE[0]),
         format!("comb: tooth = {} × κ", sig3(scale)),
     ));
     if series.len() > 1 {
