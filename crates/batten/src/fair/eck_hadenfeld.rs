@@ -473,35 +473,62 @@ impl FairMethod for EckHadenfeld {
 
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
         let fitted = local::fit_input(input, options)?;
-        let params = EckHadenfeldParams {
-            order: options.param_usize_in("order", DEFAULT_ORDER, 2, 3)?,
-            tolerance: Some(fitted.delta),
-            tabu_length: options.param_usize_in("tabu", DEFAULT_TABU_LENGTH, 0, 1000)?,
-            max_iterations: options.iterations_or(DEFAULT_MAX_ITERATIONS),
-            min_rel_decrease: DEFAULT_MIN_REL_DECREASE,
-            free_ends: fitted.free_ends,
-        };
-        let (faired, report) = fair_curve(&fitted.curve, &params)?;
-        let points = local::output_points(&faired, &fitted, input, options.fix_ends);
-        let mut parameters = fitted.parameters.clone();
-        parameters.insert("order".into(), Value::from(params.order));
-        parameters.insert("tabu".into(), params.tabu_length.into());
-        parameters.insert("max_iterations".into(), params.max_iterations.into());
-        insert_common(&mut parameters, &report);
-        let mut notes = fitted.notes;
-        notes.extend(report.notes);
-        Ok(Outcome {
-            points,
-            status: report.status,
-            iterations: report.iterations,
-            moves: report.moves,
-            history: report.history,
-            parameters,
-            notes,
-            curve: Some(faired),
-            tangents: None,
-        })
+        run_fitted(fitted, input, options)
     }
+
+    fn run_curve_supported(&self) -> bool {
+        true
+    }
+
+    fn run_curve(
+        &self,
+        curve: &BSplineCurve,
+        options: &FairOptions,
+    ) -> Option<Result<(PointSeq, Outcome)>> {
+        Some(
+            local::curve_input(curve, options).and_then(|(fitted, seq)| {
+                let out = run_fitted(fitted, &seq, options)?;
+                Ok((seq, out))
+            }),
+        )
+    }
+}
+
+/// The method on a fitted (or given) B-spline; `input` holds the points the output is
+/// compared with.
+fn run_fitted(
+    fitted: local::FittedInput,
+    input: &PointSeq,
+    options: &FairOptions,
+) -> Result<Outcome> {
+    let params = EckHadenfeldParams {
+        order: options.param_usize_in("order", DEFAULT_ORDER, 2, 3)?,
+        tolerance: Some(fitted.delta),
+        tabu_length: options.param_usize_in("tabu", DEFAULT_TABU_LENGTH, 0, 1000)?,
+        max_iterations: options.iterations_or(DEFAULT_MAX_ITERATIONS),
+        min_rel_decrease: DEFAULT_MIN_REL_DECREASE,
+        free_ends: fitted.free_ends,
+    };
+    let (faired, report) = fair_curve(&fitted.curve, &params)?;
+    let points = local::output_points(&faired, &fitted, input, options.fix_ends);
+    let mut parameters = fitted.parameters.clone();
+    parameters.insert("order".into(), Value::from(params.order));
+    parameters.insert("tabu".into(), params.tabu_length.into());
+    parameters.insert("max_iterations".into(), params.max_iterations.into());
+    insert_common(&mut parameters, &report);
+    let mut notes = fitted.notes;
+    notes.extend(report.notes);
+    Ok(Outcome {
+        points,
+        status: report.status,
+        iterations: report.iterations,
+        moves: report.moves,
+        history: report.history,
+        parameters,
+        notes,
+        curve: Some(faired),
+        tangents: None,
+    })
 }
 
 #[cfg(test)]

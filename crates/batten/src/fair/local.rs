@@ -546,6 +546,59 @@ pub(crate) fn fit_input(input: &PointSeq, options: &FairOptions) -> Result<Fitte
     })
 }
 
+/// B-spline input taken as it is (no fit): the data parameters are the Greville abscissae
+/// `ξ_i` (one per control point, the curve's natural correspondence points), the "input
+/// points" are the curve there, and δ is the tolerance, or [`DEFAULT_TOLERANCE_REL`] × the
+/// bounding-box diagonal of the control points without one. Returns the fitted-input record
+/// and the sampled points as the sequence that displacements and metrics are measured on.
+///
+/// # Errors
+/// [`crate::Error::DuplicatePoint`] and the like when the curve's points at consecutive
+/// Greville abscissae coincide; parameter errors.
+pub(crate) fn curve_input(
+    curve: &BSplineCurve,
+    options: &FairOptions,
+) -> Result<(FittedInput, PointSeq)> {
+    let p = curve.degree();
+    let u = curve.knots().as_slice();
+    let n = curve.control_points().len();
+    let params: Vec<f64> = (0..n)
+        .map(|i| u[i + 1..=i + p].iter().sum::<f64>() / p as f64)
+        .collect();
+    let seq = PointSeq::open(params.iter().map(|&t| curve.eval(t)).collect())?;
+    let mut notes = Vec::new();
+    let free = param_bool(options, "free_ends", false)?;
+    let free_ends = free && !options.fix_ends;
+    let delta = match options.tolerance {
+        Some(tol) => tol,
+        None => {
+            let scale = BBox::from_points(curve.control_points()).map_or(0.0, |b| b.diagonal());
+            let d = DEFAULT_TOLERANCE_REL * scale;
+            notes.push(format!(
+                "no tolerance given: δ = {DEFAULT_TOLERANCE_REL} × control-polygon diagonal = {d:.6e}"
+            ));
+            d
+        }
+    };
+    let mut parameters = serde_json::Map::new();
+    parameters.insert("fit".into(), "none (B-spline input)".into());
+    parameters.insert("degree".into(), p.into());
+    parameters.insert("control_points".into(), n.into());
+    parameters.insert("delta".into(), json_f64(delta));
+    parameters.insert("free_ends".into(), free_ends.into());
+    Ok((
+        FittedInput {
+            curve: curve.clone(),
+            params,
+            delta,
+            free_ends,
+            notes,
+            parameters,
+        },
+        seq,
+    ))
+}
+
 /// The output points for point input: the faired curve at the fitted parameters, same count
 /// and order; with `fix_ends` the first and last are the input's own (the curve's ends are
 /// the fixed end control points of a clamped fit, equal to them up to rounding).

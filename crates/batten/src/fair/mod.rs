@@ -78,6 +78,24 @@ pub trait FairMethod: Sync {
     /// # Errors
     /// Whatever makes the method fail (a parameter out of range, degenerate geometry).
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome>;
+
+    /// Fair a B-spline curve as it is (B-spline in, B-spline out), for methods that work on
+    /// control points. Returns the points the result is measured against (the input curve at
+    /// the method's data parameters) and the outcome, whose points are the faired curve at the
+    /// same parameters. `None` (the default): the method takes point input only.
+    fn run_curve(
+        &self,
+        curve: &BSplineCurve,
+        options: &FairOptions,
+    ) -> Option<Result<(PointSeq, Outcome)>> {
+        let _ = (curve, options);
+        None
+    }
+
+    /// Whether [`FairMethod::run_curve`] is implemented (B-spline input accepted).
+    fn run_curve_supported(&self) -> bool {
+        false
+    }
 }
 
 /// The result of [`fair`]: the faired points and the report.
@@ -130,10 +148,18 @@ pub fn default_method() -> &'static str {
 /// # Errors
 /// [`Error::UnknownMethod`] listing the known names.
 pub fn method(name: &str) -> Result<&'static dyn FairMethod> {
-    REGISTRY.iter().copied().find(|m| m.name() == name).ok_or_else(|| Error::UnknownMethod {
-        name: name.to_string(),
-        known: REGISTRY.iter().map(|m| m.name()).collect::<Vec<_>>().join(", "),
-    })
+    REGISTRY
+        .iter()
+        .copied()
+        .find(|m| m.name() == name)
+        .ok_or_else(|| Error::UnknownMethod {
+            name: name.to_string(),
+            known: REGISTRY
+                .iter()
+                .map(|m| m.name())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
 }
 
 /// Check `options` against what `method` accepts: known parameter names, a positive finite
@@ -141,9 +167,15 @@ pub fn method(name: &str) -> Result<&'static dyn FairMethod> {
 ///
 /// # Errors
 /// [`Error::UnknownOption`], [`Error::InvalidParameter`], [`Error::ClosedUnsupported`].
-pub fn check_options(method: &dyn FairMethod, input_closed: bool, options: &FairOptions) -> Result<()> {
+pub fn check_options(
+    method: &dyn FairMethod,
+    input_closed: bool,
+    options: &FairOptions,
+) -> Result<()> {
     if input_closed && !method.supports_closed() {
-        return Err(Error::ClosedUnsupported { method: method.name().to_string() });
+        return Err(Error::ClosedUnsupported {
+            method: method.name().to_string(),
+        });
     }
     options.validate()?;
     let specs = method.parameters();
@@ -183,6 +215,50 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
     let before = FairnessMetrics::of_seq(input)?;
     let start = Instant::now();
     let outcome = m.run(input, options)?;
+    finish(m, input, before, options, outcome, start)
+}
+
+/// Fair a B-spline curve with the method called `name` (B-spline in, B-spline out: knots and
+/// degree kept). Only methods that work on control points accept it (`salvi`,
+/// `eck-hadenfeld`); [`Faired::curve`] is the faired curve, and [`Faired::points`] the faired
+/// curve at the input curve's Greville abscissae, which the report's displacements and metrics
+/// are measured on.
+///
+/// # Errors
+/// As [`fair`]; [`Error::InvalidParameter`] for a method that takes point input only.
+pub fn fair_curve(name: &str, curve: &BSplineCurve, options: &FairOptions) -> Result<Faired> {
+    let m = method(name)?;
+    check_options(m, false, options)?;
+    let start = Instant::now();
+    let Some(run) = m.run_curve(curve, options) else {
+        let takes: Vec<&str> = REGISTRY
+            .iter()
+            .filter(|x| x.run_curve_supported())
+            .map(|x| x.name())
+            .collect();
+        return Err(Error::InvalidParameter {
+            name: "input".into(),
+            reason: format!(
+                "method {} takes points, not a B-spline curve (B-spline input: {})",
+                m.name(),
+                takes.join(", ")
+            ),
+        });
+    };
+    let (input, outcome) = run?;
+    let before = FairnessMetrics::of_seq(&input)?;
+    finish(m, &input, before, options, outcome, start)
+}
+
+/// The common part of every report: displacements, metrics after, the tolerance verdict.
+fn finish(
+    m: &dyn FairMethod,
+    input: &PointSeq,
+    before: FairnessMetrics,
+    options: &FairOptions,
+    outcome: Outcome,
+    start: Instant,
+) -> Result<Faired> {
     let elapsed = start.elapsed();
     if outcome.points.len() != input.len() {
         return Err(Error::LengthMismatch {
@@ -224,7 +300,12 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
         history: outcome.history,
         notes,
     };
-    Ok(Faired { points: outcome.points, report, curve: outcome.curve, tangents: outcome.tangents })
+    Ok(Faired {
+        points: outcome.points,
+        report,
+        curve: outcome.curve,
+        tangents: outcome.tangents,
+    })
 }
 
 /// Scale a proposed set of moves back so that no point ends farther than `tolerance` from its

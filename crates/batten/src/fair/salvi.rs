@@ -856,41 +856,68 @@ impl FairMethod for Salvi {
 
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
         let fitted = local::fit_input(input, options)?;
-        let params = salvi_params(options, &fitted)?;
-        let (faired, report) = fair_curve(&fitted.curve, &params)?;
-        let points = local::output_points(&faired, &fitted, input, options.fix_ends);
-        let mut parameters = fitted.parameters.clone();
-        parameters.insert("samples".into(), report.samples.len().into());
-        parameters.insert(
-            "smoother".into(),
-            Value::from(match params.smoother {
-                Smoother::BSplineFit { .. } => "bspline",
-                _ => "average",
-            }),
-        );
-        parameters.insert("pin_ends".into(), params.pin_ends.into());
-        parameters.insert("tabu".into(), params.tabu_length.into());
-        parameters.insert("window".into(), params.window.into());
-        parameters.insert("max_iterations".into(), params.max_iterations.into());
-        insert_common(&mut parameters, &report.local);
-        parameters.insert(
-            "max_curve_deviation".into(),
-            json_f64(report.max_curve_deviation),
-        );
-        let mut notes = fitted.notes;
-        notes.extend(report.local.notes);
-        Ok(Outcome {
-            points,
-            status: report.local.status,
-            iterations: report.local.iterations,
-            moves: report.local.moves,
-            history: report.local.history,
-            parameters,
-            notes,
-            curve: Some(faired),
-            tangents: None,
-        })
+        run_fitted(fitted, input, options)
     }
+
+    fn run_curve_supported(&self) -> bool {
+        true
+    }
+
+    fn run_curve(
+        &self,
+        curve: &BSplineCurve,
+        options: &FairOptions,
+    ) -> Option<Result<(PointSeq, Outcome)>> {
+        Some(
+            local::curve_input(curve, options).and_then(|(fitted, seq)| {
+                let out = run_fitted(fitted, &seq, options)?;
+                Ok((seq, out))
+            }),
+        )
+    }
+}
+
+/// The method on a fitted (or given) B-spline; `input` holds the points the output is
+/// compared with.
+fn run_fitted(
+    fitted: local::FittedInput,
+    input: &PointSeq,
+    options: &FairOptions,
+) -> Result<Outcome> {
+    let params = salvi_params(options, &fitted)?;
+    let (faired, report) = fair_curve(&fitted.curve, &params)?;
+    let points = local::output_points(&faired, &fitted, input, options.fix_ends);
+    let mut parameters = fitted.parameters.clone();
+    parameters.insert("samples".into(), report.samples.len().into());
+    parameters.insert(
+        "smoother".into(),
+        Value::from(match params.smoother {
+            Smoother::BSplineFit { .. } => "bspline",
+            _ => "average",
+        }),
+    );
+    parameters.insert("pin_ends".into(), params.pin_ends.into());
+    parameters.insert("tabu".into(), params.tabu_length.into());
+    parameters.insert("window".into(), params.window.into());
+    parameters.insert("max_iterations".into(), params.max_iterations.into());
+    insert_common(&mut parameters, &report.local);
+    parameters.insert(
+        "max_curve_deviation".into(),
+        json_f64(report.max_curve_deviation),
+    );
+    let mut notes = fitted.notes;
+    notes.extend(report.local.notes);
+    Ok(Outcome {
+        points,
+        status: report.local.status,
+        iterations: report.local.iterations,
+        moves: report.local.moves,
+        history: report.local.history,
+        parameters,
+        notes,
+        curve: Some(faired),
+        tangents: None,
+    })
 }
 
 /// Copy the common numbers of a [`LocalReport`] into the report parameters.
