@@ -5,7 +5,9 @@ use std::process::ExitCode;
 
 use anyhow::anyhow;
 use batten::fair::{self, FairReport};
-use batten::io::{self, Format, PointData, format_f64};
+use batten::io::{self, Format, IoError, PointData, ReadOptions, format_f64};
+use batten::spline::BSplineCurve;
+use batten::{Faired, PointSeq, analysis};
 
 use crate::FairArgs;
 use crate::failure::{EXIT_FAILED, Failure};
@@ -35,9 +37,59 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         check_directory(report)?;
     }
 
-    let data = input::read(&args.input, args.closed)?;
-    // A JSON file can make the curve closed: check the method against that too.
-    input::check(method, data.seq.is_closed(), &options)?;
+    if let Some(curve_out) = &args.curve_out {
+        if !matches!(Format::from_path(curve_out), Ok(Format::Json)) {
+            return Err(Failure::usage(anyhow!(
+                "{}: --curve-out writes a B-spline as JSON: give a .json file",
+                curve_out.display()
+            )));
+        }
+        check_directory(curve_out)?;
+        io::ensure_distinct(&args.input, curve_out).map_err(Failure::usage)?;
+        let clash = same_path(curve_out, &args.output)
+            || args
+                .report
+                .as_deref()
+                .is_some_and(|r| same_path(curve_out, r));
+        if clash {
+            return Err(Failure::usage(anyhow!(
+                "--curve-out {} names another output too",
+                curve_out.display()
+            )));
+        }
+    }
+
+    // A B-spline JSON file is faired as a curve (control-point methods only).
+    let source = match io::read_points(
+        &args.input,
+        &ReadOptions::default().with_closed(args.closed),
+    ) {
+        Ok(data) => Source::Points(data),
+        Err(IoError::CurveNotPoints { .. }) => {
+            Source::Curve(io::read_curve_json(&args.input).map_err(Failure::usage)?)
+        }
+        Err(e) => return Err(Failure::usage(e)),
+    };
+    match &source {
+        // A JSON file can make the curve closed: check the method against that too.
+        Source::Points(d) => input::check(method, d.seq.is_closed(), &options)?,
+        Source::Curve(_) if !method.run_curve_supported() => {
+            return Err(Failure::usage(anyhow!(
+                "{}; method {} takes points (B-spline input: {})",
+                IoError::CurveNotPoints {
+                    path: args.input.clone()
+                },
+                method.name(),
+                fair::methods()
+                    .iter()
+                    .filter(|m| m.run_curve_supported())
+                    .map(|m| m.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )));
+        }
+        Source::Curve(_) => {}
+    }
     io::ensure_distinct(&args.input, &args.output).map_err(Failure::usage)?;
     if let Some(report) = &args.report {
         io::ensure_distinct(&args.input, report).map_err(Failure::usage)?;
@@ -50,19 +102,32 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
     }
 
     let input_name = args.input.display();
-    let faired = fair::fair_with(method, &data.seq, &options).map_err(|e| {
-        Failure::from_batten(&format!("{input_name}: method {} failed", method.name()), e)
-    })?;
+    let failed =
+        |e| Failure::from_batten(&format!("{input_name}: method {} failed", method.name()), e);
+    let faired = match &source {
+        Source::Curve(curve) => fair::fair_curve(method.name(), curve, &options).map_err(failed)?,
+        Source::Points(d) => fair::fair_with(method, &d.seq, &options).map_err(failed)?,
+    };
+    let data = match &source {
+        Source::Points(d) => Some(d),
+        Source::Curve(_) => None,
+    };
+    let closed = data.is_some_and(|d| d.seq.is_closed());
 
     // Tangents: the method's, else the input's carried through.
-    let tangents = faired.tangents.as_deref().or(data.tangents.as_deref());
-    io::write_points(&args.output, &faired.points, data.seq.is_closed(), tangents)
-        .map_err(Failure::failed)?;
+    let tangents = faired
+        .tangents
+        .as_deref()
+        .or(data.and_then(|d| d.tangents.as_deref()));
+    io::write_points(&args.output, &faired.points, closed, tangents).map_err(Failure::failed)?;
     if let Some(path) = &args.report {
         write_report(path, &faired.report)?;
     }
+    if let Some(path) = &args.curve_out {
+        write_curve(path, &faired, closed)?;
+    }
 
-    output::note(&summary(&faired.report, &data));
+    output::note(&summary(&faired.report, data));
     if faired.report.tolerance_met {
         Ok(ExitCode::SUCCESS)
     } else {
@@ -103,6 +168,35 @@ pub fn same_path(a: &Path, b: &Path) -> bool {
     abs(a) == abs(b)
 }
 
+/// What `batten fair` read: a point list, or a B-spline curve (JSON).
+enum Source {
+    Points(PointData),
+    Curve(BSplineCurve),
+}
+
+/// Write the faired curve as B-spline JSON, atomically: the method's own B-spline, or the
+/// analysis curve (the C² cubic through the faired points) converted exactly to B-spline form.
+fn write_curve(path: &Path, faired: &Faired, closed: bool) -> Result<(), Failure> {
+    let converted;
+    let curve = match &faired.curve {
+        Some(c) => c,
+        None => {
+            let c = PointSeq::new(faired.points.clone(), closed)
+                .and_then(|s| analysis::analysis_curve(&s))
+                .and_then(|c| BSplineCurve::from_parametric_cubic(&c))
+                .map_err(|e| {
+                    Failure::failed(anyhow!("{}: cannot build the curve: {e}", path.display()))
+                })?;
+            converted = c;
+            &converted
+        }
+    };
+    let mut json = serde_json::to_string_pretty(curve)
+        .map_err(|e| Failure::failed(anyhow!("cannot encode the curve: {e}")))?;
+    json.push('\n');
+    io::write_atomic(path, json.as_bytes()).map_err(Failure::failed)
+}
+
 /// Write the report as pretty JSON, atomically.
 pub fn write_report(path: &Path, report: &FairReport) -> Result<(), Failure> {
     let mut json = serde_json::to_string_pretty(report)
@@ -113,12 +207,12 @@ pub fn write_report(path: &Path, report: &FairReport) -> Result<(), Failure> {
 
 /// The one-line summary: method, status, iterations, largest displacement (and where),
 /// tolerance.
-fn summary(r: &FairReport, data: &PointData) -> String {
+fn summary(r: &FairReport, data: Option<&PointData>) -> String {
     let status = serde_json::to_value(r.status)
         .ok()
         .and_then(|v| v.as_str().map(str::to_string))
         .unwrap_or_else(|| format!("{:?}", r.status));
-    let at = match data.lines.get(r.max_displacement_index) {
+    let at = match data.and_then(|d| d.lines.get(r.max_displacement_index)) {
         Some(line) if r.max_displacement > 0.0 => {
             format!(" at point {} (line {line})", r.max_displacement_index)
         }

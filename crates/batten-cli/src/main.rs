@@ -74,7 +74,8 @@ struct AnalyzeArgs {
 /// Arguments of `batten fair`.
 #[derive(Debug, Args)]
 struct FairArgs {
-    /// Point file (.csv, .txt or .json)
+    /// Point file (.csv, .txt or .json), or a B-spline curve as JSON ({"degree", "knots",
+    /// "control_points", "weights"}) for the methods that work on control points
     #[arg(value_name = "INPUT")]
     input: PathBuf,
     /// Where to write the faired points; the format follows the extension (.csv, .txt, .json).
@@ -96,6 +97,10 @@ struct FairArgs {
     /// Write the fairing report (JSON) to this file
     #[arg(long, value_name = "R.json")]
     report: Option<PathBuf>,
+    /// Also write the faired curve as a B-spline (JSON: degree, knots, control_points): the
+    /// method's own curve, or the C² cubic through the faired points for point methods
+    #[arg(long, value_name = "FILE.json")]
+    curve_out: Option<PathBuf>,
     /// A method parameter, KEY=VALUE (repeat for several; see `batten methods`)
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
