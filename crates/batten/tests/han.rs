@@ -1222,7 +1222,7 @@ proptest! {
         closed in any::<bool>(),
     ) {
         let pts = random_curve(seed, n, closed);
-        let input = if closed { PointSeq::closed(pts.clone()) } else { PointSeq::open(pts.clone()) };
+        let input = PointSeq::new(pts.clone(), closed);
         let Ok(input) = input else { return Ok(()) };
         let mut opts = FairOptions::default().with_tolerance(tol);
         if half_pi {

@@ -16,23 +16,24 @@
 //!
 //! # Spec fixes and choices used
 //!
-//! - eq 4: the three-moment equation reads `… + h_i c_{i+1} = d_i` ([FIX], §1.2);
-//! - eq 9: `h_j = x_{j+1} − x_j` in the numerator; eq 10: the forward relation below j ([FIX]);
+//! - eq 4: the three-moment equation reads `… + h_i c_{i+1} = d_i` (\[FIX\], §1.2);
+//! - eq 9: `h_j = x_{j+1} − x_j` in the numerator; eq 10: the forward relation below j (\[FIX\]);
 //! - eqs 14–15 at j = 2 and j = n−1: `ā_{j−1} = 0`, `ā*_{j+1} = 0` in the numerator and
-//!   `c̃_1^2 = c̃_2^2`, `c̃_n^{n−1} = c̃_{n−1}^{n−1}` ([FIX], §1.6);
-//! - `e_1 = e_n = 0` (flat ends, [CHOICE] §1.5); sign tests with `sgn0` and
-//!   [`ZERO_REL`](crate::analysis::ZERO_REL)` = 1e-12` relative to the largest |value| of the current array ([CHOICE] §1.7.0);
-//! - coarse case 2 end rule `e_2 e_3 < 0 ∧ e_2 e_4 < 0` and its mirror ([CHOICE/FIX] §1.7.1);
-//! - coarse case 3 end rule with `e_2 e_4 < 0`, `e_2 e_5 < 0` ([FIX] §1.7.1);
-//! - fine-phase α rule: a fifth of the smaller-magnitude neighbour, left on a tie ([CHOICE]
+//!   `c̃_1^2 = c̃_2^2`, `c̃_n^{n−1} = c̃_{n−1}^{n−1}` (\[FIX\], §1.6);
+//! - `e_1 = e_n = 0` (flat ends, \[CHOICE\] §1.5); sign tests with `sgn0` and
+//!   [`ZERO_REL`](crate::analysis::ZERO_REL) `= 1e-12` relative to the largest |value| of the
+//!   current array (\[CHOICE\] §1.7.0);
+//! - coarse case 2 end rule `e_2 e_3 < 0 ∧ e_2 e_4 < 0` and its mirror (\[CHOICE/FIX\] §1.7.1);
+//! - coarse case 3 end rule with `e_2 e_4 < 0`, `e_2 e_5 < 0` (\[FIX\] §1.7.1);
+//! - fine-phase α rule: a fifth of the smaller-magnitude neighbour, left on a tie (\[CHOICE\]
 //!   §1.7.2, reflection invariant);
 //! - fine case 2 unknowns `γ_{i−1} = −λ_f σ, γ_i = σ, γ_{i+1} = τ, γ_{i+2} = −λ_f τ`: the printed
-//!   unknowns give a singular system for mirror-symmetric spacing ([FIX/CHOICE] §1.7.2);
-//! - one iteration runs C1, C2 (+ends), C3 (+ends), F1, F2 (+ends) ([CHOICE] §1.7.3);
+//!   unknowns give a singular system for mirror-symmetric spacing (\[FIX/CHOICE\] §1.7.2);
+//! - one iteration runs C1, C2 (+ends), C3 (+ends), F1, F2 (+ends) (\[CHOICE\] §1.7.3);
 //! - unwrapped turning angles, first s with range > `max_turn`, segment `P_b..P_{s−1}`, minimum
-//!   segment length k + 2, k shared points, bisector frame from argmax/argmin ([FIX]/[CHOICE]
+//!   segment length k + 2, k shared points, bisector frame from argmax/argmin (\[FIX\]/\[CHOICE\]
 //!   §1.8); segments of one pass are faired independently from the same points and blended
-//!   with weights `q/(K+1)` ([CHOICE] §1.8.6).
+//!   with weights `q/(K+1)` (\[CHOICE\] §1.8.6).
 //!
 //! # Cost
 //!
@@ -41,14 +42,15 @@
 //! the rest from the geometric recurrences eqs 16–17 (`c̃_i^j = −a_i c̃_{i+1}^j` to the left,
 //! `−a*_i c̃_{i−1}^j` to the right, `0 < a_i, a*_i < 1/2`). After every move, `c` is updated by
 //! adding the response columns (eq 13) — the summed column of a move obeys the same
-//! recurrences outside the moved points, so it is walked outward once and cut off when it falls
-//! below [`RESPONSE_CUTOFF_REL`] of its largest entry (at most ~57 steps since each step halves
-//! it, ~32 on a uniform grid). `e` is recomputed from `c` on the changed range, and the maxima
-//! used by the sign tests are kept as per-block maxima (blocks of 32) under a small max-tree,
-//! refreshed on that range. A move therefore costs O(57 + log n) at worst (the climb usually
-//! stops after a level or two) and a sweep O(n), with no re-solve of the spline. Measured
-//! (release, one segment of a noisy sine): 10⁵ points 2 s, 10⁶ points 21 s for the default 3
-//! passes × 10 iterations, about 1.5 million moves per iteration at 10⁶.
+//! recurrences outside the moved points, so it is walked outward once and cut off when it
+//! falls below [`RESPONSE_CUTOFF_REL`] of its largest entry (at most ~57 steps since each step
+//! at least halves it, ~30 on a uniform grid). `e` is recomputed from `c` on the changed range,
+//! and the maxima used by the sign tests are kept as per-block maxima (blocks of 32) under a
+//! small max-tree, refreshed on that range. A move therefore costs O(57 + log n) at worst (the
+//! climb usually stops after a level or two) and a sweep O(n), with no re-solve of the spline.
+//! Measured (release, one segment of a noisy sine, shared machine): 10⁵ points ≈ 1 s, 10⁶
+//! points 13–18 s for the default 3 passes × 10 iterations, about 1.5 million moves per
+//! iteration at 10⁶.
 //!
 //! # Common options
 //!
@@ -63,7 +65,7 @@
 //!   at different points, so with two or more passes every point is faired; with one pass the
 //!   cut point (point 0) stays where it is.
 //! - A segment that is not a function in its bisector frame, or has a chord steeper than
-//!   [`MAX_LOCAL_SLOPE`] there ([CHOICE] guard), is left as it is and reported in the notes.
+//!   [`MAX_LOCAL_SLOPE`] there (\[CHOICE\] guard), is left as it is and reported in the notes.
 //!   Both happen when the minimum segment length extends a segment round a tight loop, or,
 //!   with `max_turn = π`, at the ends of segments of densely sampled curves (their end chords
 //!   approach the vertical); `max_turn = π/2` avoids them.
@@ -78,22 +80,22 @@ use crate::fair::FairOptions;
 use crate::geom::{Point, PointSeq, Vec2};
 use crate::spline::{CubicSplineFn, FnEndCondition};
 
-/// Default damping of coarse case 1, `λ_c` [PAPER].
+/// Default damping of coarse case 1, `λ_c` \[PAPER\].
 pub const DEFAULT_LAMBDA_COARSE: f64 = 0.8;
-/// Default weight of the outer points in the fine cases, `λ_f` [PAPER].
+/// Default weight of the outer points in the fine cases, `λ_f` \[PAPER\].
 pub const DEFAULT_LAMBDA_FINE: f64 = 0.75;
-/// Default factor of the fine-phase α rule, `α = factor · v` [PAPER: 1/5].
+/// Default factor of the fine-phase α rule, `α = factor · v` \[PAPER: 1/5\].
 pub const DEFAULT_ALPHA_FACTOR: f64 = 0.2;
-/// Default number of points shared by consecutive segments, k [PAPER].
+/// Default number of points shared by consecutive segments, k \[PAPER\].
 pub const DEFAULT_OVERLAP: usize = 5;
-/// Default number of pipeline passes (partition, fair, blend) [CHOICE].
+/// Default number of pipeline passes (partition, fair, blend) \[CHOICE\].
 pub const DEFAULT_PASSES: usize = 3;
-/// Default turning threshold of the partition, π [PAPER].
+/// Default turning threshold of the partition, π \[PAPER\].
 pub const DEFAULT_MAX_TURN: f64 = PI;
 /// The recommended turning threshold, π/2: segments then stay far from vertical local slopes,
 /// where the function-spline proxy breaks down (spec §1.8 note).
 pub const RECOMMENDED_MAX_TURN: f64 = FRAC_PI_2;
-/// Default iterations per segment, T [CHOICE §1.7.3].
+/// Default iterations per segment, T \[CHOICE §1.7.3\].
 pub const DEFAULT_ITERATIONS: usize = 10;
 /// The fewest points a function segment must have to be faired (spec §1.7).
 pub const MIN_SEGMENT_POINTS: usize = 5;
@@ -106,11 +108,11 @@ pub const RESPONSE_CUTOFF_REL: f64 = 1e-17;
 /// condition numbers below 30 on sane grids (spec §1.7).
 pub const SINGULAR_REL: f64 = 1e-12;
 /// A segment with a chord steeper than this in its bisector frame (`|ΔY/ΔX|`, ≈ 89.4°) is
-/// left unfaired ([CHOICE] guard). The function-spline proxy assumes moderate slopes (spec §1.8
+/// left unfaired (\[CHOICE\] guard). The function-spline proxy assumes moderate slopes (spec §1.8
 /// note: up to 76 seen on the strophoid with `max_turn = π`, faired with some drift). Steeper
 /// segments come from the minimum-length rule extending a segment round a tight loop until it
 /// turns by almost π; their spacing ratios reach 1e-6, the unit responses are huge and the
-/// moves diverge (we saw points thrown 10³ curve sizes away). With `max_turn = π/2` segments
+/// moves diverge (we saw a point thrown 500 curve sizes away). With `max_turn = π/2` segments
 /// have slopes ≤ 1 unless extended.
 pub const MAX_LOCAL_SLOPE: f64 = 100.0;
 /// At most this many moves are listed in the report; later moves are counted, not listed.
@@ -361,7 +363,7 @@ impl UnitResponses {
 
 /// Entries per block of [`MaxTracker`]: a block is rescanned whole when it changes, which is
 /// cheap because a move has just written it (it is in L1), and keeps the tree over blocks small
-/// enough for L2 (n/64 leaves).
+/// (n/32 leaves: 250 KB for 10⁶ points).
 const MAX_BLOCK: usize = 32;
 
 /// max |v_k| of an array under local updates: per-block maxima and an implicit binary tree
@@ -1249,7 +1251,7 @@ pub fn chord_angles(points: &[Point]) -> Result<Vec<f64>> {
         .collect()
 }
 
-/// Unwrapped turning angles (spec §1.8 step 2, [FIX]): `α_0 = 0`,
+/// Unwrapped turning angles (spec §1.8 step 2, \[FIX\]): `α_0 = 0`,
 /// `α_i = α_{i−1} + wrap(φ_i − φ_{i−1})` with wrap into (−π, π]; one per chord. `α_{N−2}` is
 /// the total turning of the polyline.
 ///
@@ -1334,7 +1336,7 @@ pub fn partition(points: &[Point], max_turn: f64, overlap: usize) -> Result<Vec<
     }
 }
 
-/// θ = φ_a + (α_u + α_l)/2 − α_a over the chords a..end−1 (spec §1.8 step 4, [FIX]).
+/// θ = φ_a + (α_u + α_l)/2 − α_a over the chords a..end−1 (spec §1.8 step 4, \[FIX\]).
 fn frame_angle(phi: &[f64], alpha: &[f64], a: usize, end: usize) -> f64 {
     let chords = &alpha[a..end];
     let (hi, lo) = chords

@@ -5,11 +5,12 @@
 //! `c_i = y''(x_i)/6` (the paper's notation). On `[x_i, x_{i+1}]` (eq 2)
 //!
 //! ```text
-//! y(x) = y_i + m_i (x − x_i) − (x − x_i)(x_{i+1} − x)/h_i · [c_i (2x_{i+1} − x − x_i) + c_{i+1}(x_{i+1} + x − 2x_i)]
+//! y(x) = y_i + m_i (x − x_i)
+//!        − (x − x_i)(x_{i+1} − x)/h_i · [c_i (2x_{i+1} − x − x_i) + c_{i+1}(x_{i+1} + x − 2x_i)]
 //! ```
 //!
 //! with `h_i = x_{i+1} − x_i` and `m_i = (y_{i+1} − y_i)/h_i`. The `c_i` solve the three-moment
-//! equations (eq 4 with the spec's **[FIX]**: the printed `c_i + 1` is `c_{i+1}`)
+//! equations (eq 4 with the spec's **\[FIX\]**: the printed `c_i + 1` is `c_{i+1}`)
 //!
 //! ```text
 //! h_{i−1} c_{i−1} + 2 (h_{i−1} + h_i) c_i + h_i c_{i+1} = m_i − m_{i−1},   i = 2..n−1
@@ -271,7 +272,7 @@ impl CubicSplineFn {
     }
 
     /// `c_j` for an interior point j (1 ≤ j ≤ n − 2, 0-based) from the explicit formula
-    /// (eq 9 with the spec's **[FIX]** `h_j = x_{j+1} − x_j` in the numerator):
+    /// (eq 9 with the spec's **\[FIX\]** `h_j = x_{j+1} − x_j` in the numerator):
     /// `c_j = (d_j − h_{j−1} b_{j−1} − h_j b*_{j+1}) / (D_j − a_{j−1} h_{j−1} − a*_{j+1} h_j)`.
     /// Equal to [`CubicSplineFn::c`]`[j]` up to rounding.
     ///
@@ -290,7 +291,7 @@ impl CubicSplineFn {
     }
 
     /// HAN's indicator `e_i = (c_{i+1} − c_i)/h_i − (c_i − c_{i−1})/h_{i−1}` for the interior
-    /// points, with `e_1 = e_n = 0` (spec §0.3, §1.5 [CHOICE]: the x–c plot extended flat).
+    /// points, with `e_1 = e_n = 0` (spec §0.3, §1.5 \[CHOICE\]: the x–c plot extended flat).
     /// `6 e_i` is the jump of `y'''` at `x_i`. Length n.
     pub fn indicator(&self) -> Vec<f64> {
         let n = self.len();
