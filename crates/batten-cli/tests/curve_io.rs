@@ -1,6 +1,8 @@
 //! B-spline curves through the CLI: `batten fair --curve-out`, and B-spline JSON input for the
 //! methods that work on control points.
 
+#![allow(clippy::unwrap_used)]
+
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

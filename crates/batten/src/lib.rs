@@ -47,5 +47,5 @@ pub use analysis::FairnessMetrics;
 pub use curve::{Curve, CurveDeriv, Derivatives, Piecewise};
 pub use error::{Error, Result};
 pub use fair::{FairOptions, FairReport, Faired};
-pub use geom::{BBox, Point, Rigid, Vec2};
 pub use geom::PointSeq;
+pub use geom::{BBox, Point, Rigid, Vec2};

@@ -1,5 +1,7 @@
 //! B-spline in, B-spline out: `fair::fair_curve` for the methods that work on control points.
 
+#![allow(clippy::unwrap_used)]
+
 use batten::fair::{self, FairOptions};
 use batten::spline::{BSplineCurve, KnotVector};
 use batten::{Curve, Error, Point};
@@ -46,7 +48,10 @@ fn control_point_methods_fair_a_bspline_directly() {
         assert!(max_distance(&curve, &bump) <= tol + 1e-12, "{method}");
         // Each method lowers its own measure (Ê for salvi, the energy for eck-hadenfeld).
         let measure = |k: &str| out.report.parameters[k].as_f64().unwrap();
-        assert!(measure("measure_after") < measure("measure_before"), "{method}");
+        assert!(
+            measure("measure_after") < measure("measure_before"),
+            "{method}"
+        );
         // Output points are the faired curve at the Greville abscissae.
         let p = curve.degree();
         let u = curve.knots().as_slice();
@@ -64,7 +69,10 @@ fn point_methods_refuse_bspline_input() {
     match err {
         Error::InvalidParameter { name, reason } => {
             assert_eq!(name, "input");
-            assert!(reason.contains("salvi") && reason.contains("eck-hadenfeld"), "{reason}");
+            assert!(
+                reason.contains("salvi") && reason.contains("eck-hadenfeld"),
+                "{reason}"
+            );
         }
         e => panic!("unexpected error {e}"),
     }

@@ -1,8 +1,8 @@
 //! Numerical building blocks, hand-written for the sizes fairing needs: O(n) banded solves,
 //! Gauss–Legendre quadrature, bracketing 1-D minimisers.
 
-mod band_lu;
 mod band_inverse;
+mod band_lu;
 mod banded;
 mod cyclic_banded;
 mod minimize;
@@ -12,8 +12,8 @@ mod tridiagonal;
 
 use std::ops::{Add, Mul, Sub};
 
-pub use band_lu::BandLu;
 pub use band_inverse::factorize_with_inverse_band;
+pub use band_lu::BandLu;
 pub use banded::SymBanded;
 pub use cyclic_banded::CyclicSymBanded;
 pub use minimize::{Minimum, minimize_brent, minimize_golden};
