@@ -14,6 +14,7 @@ mod interpolate;
 mod knots;
 mod lambda_operator;
 mod parametric;
+pub mod quintic;
 
 pub use bspline::{BSplineCurve, MAX_ORDER};
 pub use bspline_ops::{DEVIATION_SAMPLES_PER_SPAN, KnotRef, KnotRemoval, RemovalRule};
