@@ -14,6 +14,7 @@ pub mod cali;
 pub mod eck_hadenfeld;
 pub mod han;
 pub mod kjellander;
+pub mod kuragano;
 pub mod local;
 mod options;
 mod report;
@@ -120,6 +121,7 @@ static KJELLANDER: Kjellander = Kjellander;
 static POLIAKOFF: Poliakoff = Poliakoff;
 static ENERGY: Energy = Energy;
 static SAPIDIS_FARIN: SapidisFarin = SapidisFarin;
+static KURAGANO: kuragano::Kuragano = kuragano::Kuragano;
 
 static REGISTRY: &[&dyn FairMethod] = &[
     &MST,
@@ -131,6 +133,7 @@ static REGISTRY: &[&dyn FairMethod] = &[
     &POLIAKOFF,
     &ENERGY,
     &SAPIDIS_FARIN,
+    &KURAGANO,
 ];
 
 /// Every registered method, the default first.
