@@ -13,6 +13,7 @@
 mod analyze;
 mod batch;
 mod compare;
+mod evaluate;
 mod failure;
 mod fair_cmd;
 mod input;
@@ -55,6 +56,8 @@ enum Command {
     Report(report::ReportArgs),
     /// Fair many point files in parallel into OUT_DIR, with a report each and a summary
     Batch(batch::BatchArgs),
+    /// Kuragano & Yamaguchi's fairness evaluation: which polynomial ρ(s) the curve follows best
+    Evaluate(evaluate::EvaluateArgs),
 }
 
 /// Arguments of `batten analyze`.
@@ -154,6 +157,7 @@ fn main() -> ExitCode {
         Command::Plot(a) => plot::run(&a),
         Command::Report(a) => report::run(&a),
         Command::Batch(a) => batch::run(&a),
+        Command::Evaluate(a) => evaluate::run(&a),
     };
     match result {
         Ok(code) => code,
