@@ -20,6 +20,9 @@ pub struct ArcLengthTable {
 const NEWTON_MAX: usize = 50;
 /// Relative accuracy of `t(s)` against the span width.
 const NEWTON_REL: f64 = 1e-14;
+/// Newton also stops when its step is below this many ulps of t: far from 0, one ulp of t
+/// exceeds `NEWTON_REL` of a span.
+const PARAM_ULPS: f64 = 4.0;
 
 impl ArcLengthTable {
     /// Build the table for `curve`.
@@ -101,11 +104,19 @@ impl ArcLengthTable {
                 lo = t;
             }
             let speed = curve.derivatives(t).d1.length();
-            let mut next = if speed > 0.0 {
-                t - f / speed
+            let step = if speed > 0.0 {
+                f / speed
             } else {
-                0.5 * (lo + hi)
+                f64::INFINITY
             };
+            // Converged: test before the bracket, which the root may have become (the Newton
+            // point then falls on it and bisection would take over), at what t can resolve.
+            let resolution = NEWTON_REL * (self.breaks[i + 1] - self.breaks[i])
+                + PARAM_ULPS * f64::EPSILON * t.abs();
+            if step.abs() <= resolution {
+                return (t - step).clamp(self.breaks[i], self.breaks[i + 1]);
+            }
+            let mut next = t - step;
             if !(next > lo && next < hi) {
                 next = 0.5 * (lo + hi);
             }
