@@ -23,7 +23,7 @@ use std::ops::Range;
 
 use serde::Serialize;
 
-use super::{FairOptions, FairStatus, HistoryRow, Move, ParamSpec};
+use super::{FairOptions, FairStatus, HistoryRow, Move, Outcome, ParamSpec};
 use crate::curve::Curve;
 use crate::error::{Error, Result};
 use crate::geom::{BBox, Point, PointSeq};
@@ -597,6 +597,21 @@ pub(crate) fn curve_input(
         },
         seq,
     ))
+}
+
+/// Run a control-point method on a given B-spline (see [`curve_input`]): `run` gets the
+/// curve as its "fit" and the points it is measured against.
+///
+/// # Errors
+/// Those of [`curve_input`] and of `run`.
+pub(crate) fn on_curve(
+    curve: &BSplineCurve,
+    options: &FairOptions,
+    run: impl FnOnce(FittedInput, &PointSeq, &FairOptions) -> Result<Outcome>,
+) -> Result<(PointSeq, Outcome)> {
+    let (fitted, seq) = curve_input(curve, options)?;
+    let out = run(fitted, &seq, options)?;
+    Ok((seq, out))
 }
 
 /// The output points for point input: the faired curve at the fitted parameters, same count

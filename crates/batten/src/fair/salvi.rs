@@ -868,12 +868,7 @@ impl FairMethod for Salvi {
         curve: &BSplineCurve,
         options: &FairOptions,
     ) -> Option<Result<(PointSeq, Outcome)>> {
-        Some(
-            local::curve_input(curve, options).and_then(|(fitted, seq)| {
-                let out = run_fitted(fitted, &seq, options)?;
-                Ok((seq, out))
-            }),
-        )
+        Some(local::on_curve(curve, options, run_fitted))
     }
 }
 
