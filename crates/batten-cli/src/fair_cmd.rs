@@ -72,7 +72,8 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
     };
     match &source {
         // A JSON file can make the curve closed: check the method against that too.
-        Source::Points(d) => input::check(method, d.seq.is_closed(), &options)?,
+        Source::Points(d) => fair::check_options(method, d.seq.is_closed(), &options)
+            .map_err(|e| Failure::from_batten(&args.input.display().to_string(), e))?,
         Source::Curve(_) if !method.run_curve_supported() => {
             return Err(Failure::usage(anyhow!(
                 "{}; method {} takes points (B-spline input: {})",
