@@ -30,12 +30,7 @@ pub struct FairnessIndicators {
 
 /// LFI and GFI of a B-spline curve (spec §4.4).
 pub fn fairness_indicators(curve: &BSplineCurve) -> FairnessIndicators {
-    let p = curve.degree();
-    let u = curve.knots().as_slice();
-    let m = curve.control_points().len() - 1;
-    let xi: Vec<f64> = (0..=m)
-        .map(|i| u[i + 1..=i + p].iter().sum::<f64>() / p as f64)
-        .collect();
+    let xi = curve.knots().greville(curve.degree());
     let kappa: Vec<f64> = xi
         .iter()
         .map(|&t| signed_curvature(&curve.derivatives(t)))

@@ -560,11 +560,8 @@ pub(crate) fn curve_input(
     options: &FairOptions,
 ) -> Result<(FittedInput, PointSeq)> {
     let p = curve.degree();
-    let u = curve.knots().as_slice();
     let n = curve.control_points().len();
-    let params: Vec<f64> = (0..n)
-        .map(|i| u[i + 1..=i + p].iter().sum::<f64>() / p as f64)
-        .collect();
+    let params = curve.knots().greville(p);
     let seq = PointSeq::open(params.iter().map(|&t| curve.eval(t)).collect())?;
     let mut notes = Vec::new();
     let free = param_bool(options, "free_ends", false)?;

@@ -118,6 +118,16 @@ impl KnotVector {
         lo
     }
 
+    /// The Greville (Schoenberg, "correspondence") abscissae of a degree-`p` spline on these
+    /// knots: `ξ_i = (u_{i+1} + … + u_{i+p}) / p`, one per control point (spec §0.5).
+    pub fn greville(&self, p: usize) -> Vec<f64> {
+        let u = &self.0;
+        let n = u.len().saturating_sub(p + 1);
+        (0..n)
+            .map(|i| u[i + 1..=i + p].iter().sum::<f64>() / p as f64)
+            .collect()
+    }
+
     /// Insert a knot value, keeping the order (used by knot insertion).
     pub(crate) fn insert(&mut self, index: usize, u: f64) {
         self.0.insert(index, u);
@@ -166,5 +176,11 @@ mod tests {
         assert_eq!(k.find_span(3, 8, 0.99), 7);
         assert_eq!(k.find_span(3, 8, 1.0), 7);
         assert_eq!(k.multiplicity(1.0), 4);
+        let xi = k.greville(3);
+        assert_eq!(xi.len(), 8);
+        let expected = [0.0, 0.2 / 3.0, 0.2, 0.4, 0.6, 0.8, 2.8 / 3.0, 1.0];
+        for (a, b) in xi.iter().zip(expected) {
+            assert!((a - b).abs() < 1e-15, "{a} vs {b}");
+        }
     }
 }

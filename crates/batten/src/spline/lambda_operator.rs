@@ -112,9 +112,7 @@ impl LambdaOperator {
             return Err(Error::InvalidKnots("the parameter domain is empty".into()));
         }
         let pf = p as f64;
-        let xi: Vec<f64> = (0..=m)
-            .map(|i| u[i + 1..=i + p].iter().sum::<f64>() / pf)
-            .collect();
+        let xi = knots.greville(p);
         let eta: Vec<f64> = (0..=m + 1)
             .map(|i| u[i..=i + p].iter().sum::<f64>() / (pf + 1.0))
             .collect();
