@@ -843,11 +843,12 @@ fn inflections(pts: &[Point]) -> usize {
 
 #[test]
 fn strophoid_ends_with_the_clean_inflection_count() {
-    // The paper's Fig. 5 experiment over 10 seeds. With the default max_turn = π, segments
+    // The paper's Fig. 5 experiment over 10 seeds. With the paper's max_turn = π, segments
     // reach near-vertical local slopes where the function-spline proxy breaks down: the count
     // drops (≈ 42 → 5) but not to the clean count, and the points drift from the curve (spec
-    // §1.8 note). With max_turn = π/2 (recommended), 9 of the 10 seeds end with the clean
-    // count and the tenth with one more, as in the spec (30 → 0.1 discrete inflections).
+    // §1.8 note). With max_turn = π/2 (recommended, the default), 9 of the 10 seeds end with
+    // the clean count and the tenth with one more, as in the spec (30 → 0.1 discrete
+    // inflections).
     let clean = strophoid(65, -2.0, 2.0);
     let want = inflections(&clean);
     let dense = strophoid(50_001, -2.5, 2.5);
@@ -862,14 +863,15 @@ fn strophoid_ends_with_the_clean_inflection_count() {
             .sum::<f64>()
             / p.len() as f64
     };
-    let half_pi = FairOptions::default().with_param("max_turn", "pi/2");
+    let half_pi = FairOptions::default();
+    let paper = FairOptions::default().with_param("max_turn", "pi");
     let (mut exact, mut d_before, mut d_after) = (0, 0.0, 0.0);
     for seed in 1..=10 {
         let (_, noisy) = noisy_strophoid(seed);
         let input = PointSeq::open(noisy.clone()).unwrap();
         let before = inflections(&noisy);
         assert!(before > want + 20);
-        let pi = fair::fair("han", &input, &FairOptions::default()).unwrap();
+        let pi = fair::fair("han", &input, &paper).unwrap();
         assert!(inflections(&pi.points) < before);
         let out = fair::fair("han", &input, &half_pi).unwrap();
         let got = inflections(&out.points);
@@ -906,6 +908,34 @@ fn regression_hairpin_segment_threw_points_away() {
         out.report.max_displacement
     );
     assert!(out.report.notes.iter().any(|n| n.contains("too steep")));
+}
+
+#[test]
+fn steep_segments_are_re_partitioned_with_the_papers_max_turn() {
+    // A densely sampled noisy arc turning by 1.5π: with max_turn = π every segment turns by
+    // almost π, so its end chords are nearly vertical in its bisector frame. Such segments are
+    // re-partitioned with π/2 rather than left unfaired.
+    let n = 3000;
+    let mut rng = Rng::new(7);
+    let pts: Vec<Point> = (0..n)
+        .map(|i| {
+            let a = 1.5 * PI * i as f64 / (n - 1) as f64;
+            let wobble = if i == 0 || i == n - 1 {
+                0.0
+            } else {
+                rng.normal(2e-4)
+            };
+            Point::new((5.0 + wobble) * a.cos(), (5.0 + wobble) * a.sin())
+        })
+        .collect();
+    let input = PointSeq::open(pts).unwrap();
+    let paper = FairOptions::default().with_param("max_turn", "pi");
+    let out = fair::fair("han", &input, &paper).unwrap();
+    let notes = out.report.notes.join("\n");
+    assert!(notes.contains("re-partitioned"), "{notes}");
+    assert!(!notes.contains("left unfaired"), "{notes}");
+    assert!(out.report.after.inflections * 2 < out.report.before.inflections);
+    assert!(out.report.max_displacement < 0.01);
 }
 
 #[test]
@@ -968,7 +998,10 @@ fn fairs_a_noisy_sine_curve() {
         assert_eq!(out.points[29], pts[29]);
         assert!(!out.report.moves.is_empty());
         assert_eq!(out.report.history.len(), out.report.iterations);
-        assert_eq!(out.report.parameters["max_turn"], serde_json::json!(PI));
+        assert_eq!(
+            out.report.parameters["max_turn"],
+            serde_json::json!(FRAC_PI_2)
+        );
         // Spec: median max displacement ≈ 2× the noise.
         assert!(out.report.max_displacement < 0.15, "seed {seed}");
     }

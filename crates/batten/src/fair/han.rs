@@ -64,11 +64,16 @@
 //!   repeated at the end, both copies fixed), and writes the result back. Successive passes cut
 //!   at different points, so with two or more passes every point is faired; with one pass the
 //!   cut point (point 0) stays where it is.
+//! - **`max_turn`** defaults to π/2, the value the spec recommends, not the paper's π
+//!   (\[CHOICE\], [`DEFAULT_MAX_TURN`]; `--set max_turn=pi` restores the paper's). With π a
+//!   densely sampled segment's end chords are nearly vertical in its frame, and on the peer
+//!   comparison π leaves more spurious inflections than csaps while π/2 leaves fewer.
 //! - A segment that is not a function in its bisector frame, or has a chord steeper than
-//!   [`MAX_LOCAL_SLOPE`] there (\[CHOICE\] guard), is left as it is and reported in the notes.
-//!   Both happen when the minimum segment length extends a segment round a tight loop, or,
-//!   with `max_turn = π`, at the ends of segments of densely sampled curves (their end chords
-//!   approach the vertical); `max_turn = π/2` avoids them.
+//!   [`MAX_LOCAL_SLOPE`] there (\[CHOICE\] guard), is re-partitioned with half the turning
+//!   threshold, down to [`MIN_FALLBACK_TURN`] = π/8, and otherwise left as it is; both are
+//!   reported in the notes. This happens with `max_turn = π` at the ends of segments of
+//!   densely sampled curves (their end chords approach the vertical), and when the minimum
+//!   segment length extends a segment round a tight loop.
 
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::ops::Range;
@@ -90,11 +95,19 @@ pub const DEFAULT_ALPHA_FACTOR: f64 = 0.2;
 pub const DEFAULT_OVERLAP: usize = 5;
 /// Default number of pipeline passes (partition, fair, blend) \[CHOICE\].
 pub const DEFAULT_PASSES: usize = 3;
-/// Default turning threshold of the partition, π \[PAPER\].
-pub const DEFAULT_MAX_TURN: f64 = PI;
-/// The recommended turning threshold, π/2: segments then stay far from vertical local slopes,
-/// where the function-spline proxy breaks down (spec §1.8 note).
-pub const RECOMMENDED_MAX_TURN: f64 = FRAC_PI_2;
+/// The paper's turning threshold of the partition, π \[PAPER\] (`--set max_turn=pi`).
+pub const PAPER_MAX_TURN: f64 = PI;
+/// Default turning threshold of the partition, π/2 \[CHOICE\]: the value the spec recommends
+/// (§1.8 note). Segments then stay far from vertical local slopes, where the function-spline
+/// proxy breaks down; with the paper's π the end chords of a densely sampled segment are
+/// nearly vertical in its frame. Measured on the peer comparison (`bench/compare_peers.py`),
+/// π/2 is what makes `han` leave fewer spurious inflections than csaps.
+pub const DEFAULT_MAX_TURN: f64 = FRAC_PI_2;
+/// The recommended turning threshold: the default, π/2.
+pub const RECOMMENDED_MAX_TURN: f64 = DEFAULT_MAX_TURN;
+/// A segment that is too steep in its frame is re-partitioned with half the turning
+/// threshold, down to this one; below it the segment is left unfaired (\[CHOICE\]).
+pub const MIN_FALLBACK_TURN: f64 = PI / 8.0;
 /// Default iterations per segment, T \[CHOICE §1.7.3\].
 pub const DEFAULT_ITERATIONS: usize = 10;
 /// The fewest points a function segment must have to be faired (spec §1.7).
@@ -1455,6 +1468,8 @@ struct RunLog {
     total_moves: usize,
     limited: bool,
     skipped: Vec<(usize, usize)>,
+    /// Segments that were too steep in their frame and were re-partitioned.
+    refined: usize,
 }
 
 impl RunLog {
@@ -1482,12 +1497,14 @@ struct PassCtx<'a> {
     pass: usize,
 }
 
-/// Fair one open sequence `cur` (whose input positions are `orig`) in place: partition, fair
-/// every segment from the same points, blend. `index_of` maps a position in `cur` to the
-/// caller's point index. Returns the number of moves.
+/// Fair one open sequence `cur` (whose input positions are `orig`) in place: partition with
+/// the turning threshold `max_turn`, fair every segment from the same points, blend.
+/// `index_of` maps a position in `cur` to the caller's point index. Returns the number of
+/// moves.
 fn open_pass(
     cur: &mut [Point],
     orig: &[Point],
+    max_turn: f64,
     ctx: &PassCtx<'_>,
     index_of: &dyn Fn(usize) -> usize,
     log: &mut RunLog,
@@ -1495,13 +1512,22 @@ fn open_pass(
     if cur.len() < MIN_SEGMENT_POINTS {
         return Ok(0);
     }
-    let spans = partition(cur, ctx.params.max_turn, ctx.params.overlap)?;
+    let spans = partition(cur, max_turn, ctx.params.overlap)?;
     let mut out = cur.to_vec();
     let mut moves = 0;
     let mut covered_to: Option<usize> = None;
     for span in &spans {
         let range = span.start..span.end + 1;
-        let (faired, m) = fair_span(&cur[range.clone()], &orig[range], span, ctx, index_of, log)?;
+        let sub_index = |m: usize| index_of(span.start + m);
+        let (faired, m) = fair_span(
+            &cur[range.clone()],
+            &orig[range],
+            span,
+            max_turn,
+            ctx,
+            &sub_index,
+            log,
+        )?;
         moves += m;
         // Blend the points shared with what is already there (spec §1.8.6): w_q = q/(K+1).
         let shared = covered_to.map_or(0, |c| (c + 1).saturating_sub(span.start));
@@ -1520,12 +1546,16 @@ fn open_pass(
     Ok(moves)
 }
 
-/// Fair the points of one span in its local frame; returns the new points and the number of
-/// moves. Spans that are too short or not a function in their frame come back unchanged.
+/// Fair the points of one span (partitioned with `max_turn`) in its local frame; returns the
+/// new points and the number of moves. `index_of` maps a position in the span to the caller's
+/// point index. A span that is not a function in its frame, or too steep there, is
+/// re-partitioned with half the threshold (down to [`MIN_FALLBACK_TURN`]) and otherwise left
+/// unchanged, as are spans that are too short.
 fn fair_span(
     pts: &[Point],
     orig: &[Point],
     span: &Span,
+    max_turn: f64,
     ctx: &PassCtx<'_>,
     index_of: &dyn Fn(usize) -> usize,
     log: &mut RunLog,
@@ -1543,7 +1573,17 @@ fn fair_span(
         .zip(ys.windows(2))
         .any(|(x, y)| !(x[1] > x[0] && (y[1] - y[0]).abs() <= MAX_LOCAL_SLOPE * (x[1] - x[0])));
     if too_steep {
-        log.skipped.push((index_of(span.start), index_of(span.end)));
+        let half = max_turn / 2.0;
+        if half >= MIN_FALLBACK_TURN && pts.len() > ctx.params.overlap + 2 {
+            // Dense sampling puts the end chords of a segment that turns by almost max_turn
+            // close to ±max_turn/2 in its frame: with the paper's π, nearly vertical. Halving
+            // the threshold brings them down to ±π/4.
+            log.refined += 1;
+            let mut sub = pts.to_vec();
+            let moves = open_pass(&mut sub, orig, half, ctx, index_of, log)?;
+            return Ok((sub, moves));
+        }
+        log.skipped.push((index_of(0), index_of(pts.len() - 1)));
         return Ok((pts.to_vec(), 0));
     }
     let mut seg = Segment::new(xs.clone(), ys.clone())?.with_params(ctx.params.segment)?;
@@ -1564,7 +1604,7 @@ fn fair_span(
     let mut moves = 0;
     seg.fair(ctx.params.iterations, |m| {
         moves += 1;
-        log.record(ctx.pass, index_of(span.start + m.i), m);
+        log.record(ctx.pass, index_of(m.i), m);
     });
     let faired = pts
         .iter()
@@ -1639,13 +1679,20 @@ impl FairMethod for Han {
                 let mut open: Vec<Point> = (0..=n).map(|m| cur[(cut + m) % n]).collect();
                 let open_orig: Vec<Point> = (0..=n).map(|m| orig[(cut + m) % n]).collect();
                 let index_of = move |m: usize| (cut + m) % n;
-                let moves = open_pass(&mut open, &open_orig, &ctx, &index_of, &mut log)?;
+                let moves = open_pass(
+                    &mut open,
+                    &open_orig,
+                    params.max_turn,
+                    &ctx,
+                    &index_of,
+                    &mut log,
+                )?;
                 for (m, p) in open.iter().take(n).enumerate() {
                     cur[(cut + m) % n] = *p;
                 }
                 moves
             } else {
-                open_pass(&mut cur, orig, &ctx, &|m| m, &mut log)?
+                open_pass(&mut cur, orig, params.max_turn, &ctx, &|m| m, &mut log)?
             };
             passes_done += 1;
             last_pass_moves = moves;
@@ -1685,11 +1732,18 @@ impl FairMethod for Han {
                 .collect();
             notes.push(format!(
                 "{} segments were too steep in their frame (X not increasing or a chord steeper \
-                 than {MAX_LOCAL_SLOPE}:1) and were left unfaired: {}{}; max_turn = pi/2 avoids \
-                 this",
+                 than {MAX_LOCAL_SLOPE}:1) even with max_turn halved down to pi/8, and were left \
+                 unfaired: {}{}",
                 log.skipped.len(),
                 list.join(", "),
                 if log.skipped.len() > 10 { ", …" } else { "" }
+            ));
+        }
+        if log.refined > 0 {
+            notes.push(format!(
+                "{} segments were too steep in their frame and were re-partitioned with half \
+                 the turning threshold",
+                log.refined
             ));
         }
         if log.total_moves > log.moves.len() {
