@@ -1,0 +1,99 @@
+//! The `han` method (Han et al., spec §1) for n = 10³ … 10⁶ points: the whole method with the
+//! default options (partition, 3 passes × 10 iterations per segment, blending) on the spiral of
+//! `benches/mst.rs`, and one sweep (one iteration of the five case procedures C1, C2, C3, F1,
+//! F2) over a single function segment, so that the per-sweep cost is visible on its own.
+//!
+//! The 10⁶ whole-method case takes several seconds a run; Criterion may warn that it extended
+//! the measurement time.
+//!
+//! Run: `cargo bench -p batten --bench han -- --warm-up-time 1 --measurement-time 5`
+
+#![allow(clippy::unwrap_used)]
+
+use std::hint::black_box;
+
+use batten::fair::han::Segment;
+use batten::fair::{FairMethod, Han};
+use batten::{FairOptions, Point, PointSeq};
+use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+
+const SIZES: [usize; 4] = [1_000, 10_000, 100_000, 1_000_000];
+
+/// The deterministic pseudo-random noise of the benchmarks, uniform in [−0.5, 0.5).
+fn noise_source() -> impl FnMut() -> f64 {
+    let mut state = 0x2545_F491_4F6C_DD1D_u64;
+    move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    }
+}
+
+/// The benchmark curve (the same as `benches/mst.rs` and `bench/csaps_speed.py`): a spiral arc
+/// with a deterministic pseudo-random wobble of 1% of the point spacing.
+fn curve(n: usize) -> Vec<Point> {
+    let mut noise = noise_source();
+    let step = 6.0 * std::f64::consts::PI / n as f64;
+    (0..n)
+        .map(|i| {
+            let a = i as f64 * step;
+            let r = 1.0 + 0.3 * a;
+            let e = 0.01 * step * r;
+            Point::new(r * a.cos() + e * noise(), r * a.sin() + e * noise())
+        })
+        .collect()
+}
+
+/// One function segment: `x_i = i·h` over three periods of `y = sin(x/2)`, with the same
+/// deterministic wobble of 1% of h on y.
+fn segment(n: usize) -> Segment {
+    let mut noise = noise_source();
+    let h = 12.0 * std::f64::consts::PI / n as f64;
+    let x: Vec<f64> = (0..n).map(|i| i as f64 * h).collect();
+    let y: Vec<f64> = x
+        .iter()
+        .map(|&v| (v / 2.0).sin() + 0.01 * h * noise())
+        .collect();
+    Segment::new(x, y).unwrap()
+}
+
+fn bench(c: &mut Criterion) {
+    // The whole method with the default options.
+    let mut g = c.benchmark_group("han");
+    g.sample_size(10);
+    for n in SIZES {
+        let seq = PointSeq::open(curve(n)).unwrap();
+        let opts = FairOptions::default();
+        g.throughput(Throughput::Elements(n as u64));
+        g.bench_with_input(BenchmarkId::new("method", n), &n, |b, _| {
+            b.iter(|| Han.run(black_box(&seq), &opts).unwrap())
+        });
+    }
+    g.finish();
+
+    // One sweep (one iteration of the five case procedures) over one segment, from the same
+    // starting state each time; the clone is not timed.
+    let mut g = c.benchmark_group("han_segment");
+    for n in SIZES {
+        let seg = segment(n);
+        g.throughput(Throughput::Elements(n as u64));
+        if n >= 100_000 {
+            g.sample_size(10);
+        }
+        g.bench_with_input(BenchmarkId::new("sweep", n), &n, |b, _| {
+            b.iter_batched(
+                || seg.clone(),
+                |mut s| {
+                    s.fair(1, |_| {});
+                    s
+                },
+                BatchSize::LargeInput,
+            )
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
