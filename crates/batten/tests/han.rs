@@ -1303,7 +1303,8 @@ proptest! {
             for (p, q) in xa.iter().chain(&ya).zip(xb.iter().chain(&yb)) {
                 prop_assert!((p - q).abs() <= 1e-12 * scale);
             }
-            // Segments `fair` leaves alone (too steep, see MAX_LOCAL_SLOPE) are not compared.
+            // Segments `fair` re-partitions or leaves alone (too steep, see MAX_LOCAL_SLOPE) are
+            // not compared.
             let steep = xa.windows(2).zip(ya.windows(2)).any(|(x, y)| {
                 !(x[1] > x[0] && (y[1] - y[0]).abs() <= 0.99 * han::MAX_LOCAL_SLOPE * (x[1] - x[0]))
             });
@@ -1319,7 +1320,10 @@ proptest! {
             }
         }
         if all_same {
-            let opts = FairOptions::default().with_param("passes", "1");
+            // The same partition as `local_segments`.
+            let opts = FairOptions::default()
+                .with_param("passes", "1")
+                .with_param("max_turn", "pi");
             let a = fair::fair("han", &input, &opts).unwrap();
             let b = fair::fair("han", &PointSeq::open(moved).unwrap(), &opts).unwrap();
             for (p, q) in a.points.iter().zip(&b.points) {

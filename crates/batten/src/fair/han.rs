@@ -79,7 +79,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use std::ops::Range;
 
 use super::{FairMethod, FairStatus, HistoryRow, Move, Outcome, ParamSpec, clamp_to_tolerance};
-use crate::analysis::{count_sign_changes, sgn0};
+use crate::analysis::{ZERO_REL, count_sign_changes, sgn0};
 use crate::error::{Error, Result};
 use crate::fair::FairOptions;
 use crate::geom::{Point, PointSeq, Vec2};
@@ -312,12 +312,13 @@ impl UnitResponses {
     }
 
     /// Eq 13 for a move of the consecutive interior points `start, start+1, …` by `gammas`:
-    /// `c ← c + Σ γ_j c̃^j`. Returns the inclusive index range of `c` that changed. Entries
-    /// below [`RESPONSE_CUTOFF_REL`] of the largest change are not added. O(57 + len²).
+    /// `c ← c + Σ γ_j c̃^j`. Returns the inclusive index range of `c` that changed and the
+    /// largest new |c_i| on it. Entries below [`RESPONSE_CUTOFF_REL`] of the largest change
+    /// are not added. O(57 + len²).
     ///
     /// # Panics
     /// When the moved points are not all interior or `c` has the wrong length.
-    pub fn add_columns(&self, start: usize, gammas: &[f64], c: &mut [f64]) -> (usize, usize) {
+    pub fn add_columns(&self, start: usize, gammas: &[f64], c: &mut [f64]) -> Changed {
         let n = self.len();
         assert_eq!(c.len(), n, "add_columns: c has the wrong length");
         assert!(
@@ -338,11 +339,17 @@ impl UnitResponses {
             *slot = s;
             big = big.max(s.abs());
         }
-        for (ci, d) in c[lo..=hi].iter_mut().zip(&core[..width]) {
+        let mut changed = Changed {
+            lo,
+            hi,
+            max: 0.0,
+            at: lo,
+        };
+        for ((k, ci), d) in c[lo..=hi].iter_mut().enumerate().zip(&core[..width]) {
             *ci += d;
+            changed.see(lo + k, *ci);
         }
         let cut = RESPONSE_CUTOFF_REL * big;
-        let (mut first, mut last) = (lo, hi);
         // Left of the moved points every column obeys c̃_i = −a_i c̃_{i+1}, so the sum does.
         let mut d = core[0];
         let mut i = lo;
@@ -353,7 +360,8 @@ impl UnitResponses {
                 break;
             }
             c[i] += d;
-            first = i;
+            changed.see(i, c[i]);
+            changed.lo = i;
         }
         let mut d = core[width - 1];
         let mut i = hi;
@@ -364,75 +372,109 @@ impl UnitResponses {
                 break;
             }
             c[i] += d;
-            last = i;
+            changed.see(i, c[i]);
+            changed.hi = i;
         }
-        (first, last)
+        changed
+    }
+}
+
+/// The entries of an array that a local update rewrote: `lo..=hi`, and the largest new
+/// magnitude among them, `max = |v[at]|`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Changed {
+    /// First rewritten index.
+    pub lo: usize,
+    /// Last rewritten index (inclusive).
+    pub hi: usize,
+    /// Largest |v_i| on `lo..=hi` after the update.
+    pub max: f64,
+    /// An index where it is reached.
+    pub at: usize,
+}
+
+impl Changed {
+    fn see(&mut self, i: usize, v: f64) {
+        let a = v.abs();
+        if a > self.max {
+            self.max = a;
+            self.at = i;
+        }
     }
 }
 
 // ---------------------------------------------------------------------------------------------
-// Maximum tracking for the sign tests
+// Exact sign tests under local updates
 // ---------------------------------------------------------------------------------------------
 
-/// Entries per block of [`MaxTracker`]: a block is rescanned whole when it changes, which is
-/// cheap because a move has just written it (it is in L1), and keeps the tree over blocks small
-/// (n/32 leaves: 250 KB for 10⁶ points).
-const MAX_BLOCK: usize = 32;
-
-/// max |v_k| of an array under local updates: per-block maxima and an implicit binary tree
-/// over them. Updating a contiguous range of r entries costs O(r + MAX_BLOCK + log n) at
-/// worst; the maximum is O(1).
+/// `sgn0(v, max_k |v_k|)` (spec §1.7.0) for an array under local updates, without keeping the
+/// maximum itself exact: an upper bound (raised by every written value) and a lower bound (the
+/// magnitude of one tracked entry) decide almost every test; only a value between
+/// `ZERO_REL·lower` and `ZERO_REL·upper` needs the exact maximum, which is then rescanned and
+/// both bounds are reset to it. The result is the same as with the exact maximum.
 #[derive(Clone, Debug)]
-struct MaxTracker {
-    blocks: Vec<f64>,
-    size: usize,
-    node: Vec<f64>,
+struct SignScale {
+    /// At least max |v_k|.
+    upper: f64,
+    /// `|v[at]|`, so at most max |v_k|.
+    lower: f64,
+    at: usize,
+    /// Number of full rescans (for tests and tuning).
+    rescans: usize,
 }
 
-impl MaxTracker {
-    fn new(values: &[f64]) -> MaxTracker {
-        let blocks: Vec<f64> = values.chunks(MAX_BLOCK).map(abs_max).collect();
-        let size = blocks.len().next_power_of_two().max(1);
-        let mut node = vec![0.0; 2 * size];
-        node[size..size + blocks.len()].copy_from_slice(&blocks);
-        for k in (1..size).rev() {
-            node[k] = node[2 * k].max(node[2 * k + 1]);
+impl SignScale {
+    fn new(values: &[f64]) -> SignScale {
+        let (at, m) = abs_argmax(values);
+        SignScale {
+            upper: m,
+            lower: m,
+            at,
+            rescans: 0,
         }
-        MaxTracker { blocks, size, node }
     }
 
-    fn max(&self) -> f64 {
-        self.node[1]
+    /// The entries `w.lo..=w.hi` of `values` were rewritten.
+    fn wrote(&mut self, values: &[f64], w: Changed) {
+        if w.max > self.upper {
+            self.upper = w.max;
+        }
+        if (w.lo..=w.hi).contains(&self.at) {
+            self.lower = values[self.at].abs();
+        }
+        if w.max > self.lower {
+            self.lower = w.max;
+            self.at = w.at;
+        }
     }
 
-    /// Entries `lo..=hi` of `values` changed.
-    fn update(&mut self, values: &[f64], lo: usize, hi: usize) {
-        let (b0, b1) = (lo / MAX_BLOCK, hi / MAX_BLOCK);
-        let mut changed = false;
-        for b in b0..=b1 {
-            let end = ((b + 1) * MAX_BLOCK).min(values.len());
-            let m = abs_max(&values[b * MAX_BLOCK..end]);
-            if m != self.blocks[b] {
-                self.blocks[b] = m;
-                self.node[self.size + b] = m;
-                changed = true;
-            }
+    /// `sgn0(values[i], max |values|)`.
+    fn sign(&mut self, values: &[f64], i: usize) -> i8 {
+        let v = values[i];
+        let a = v.abs();
+        if a <= ZERO_REL * self.lower {
+            return 0;
         }
-        // Climb while something changed; most updates stop within a level or two.
-        let (mut l, mut r) = ((self.size + b0) / 2, (self.size + b1) / 2);
-        while changed && l >= 1 {
-            changed = false;
-            for k in l..=r {
-                let m = self.node[2 * k].max(self.node[2 * k + 1]);
-                if m != self.node[k] {
-                    self.node[k] = m;
-                    changed = true;
-                }
-            }
-            l /= 2;
-            r /= 2;
+        if a > ZERO_REL * self.upper {
+            return if v > 0.0 { 1 } else { -1 };
         }
+        self.rescan(values);
+        sgn0(v, self.upper)
     }
+
+    fn rescan(&mut self, values: &[f64]) {
+        let (at, m) = abs_argmax(values);
+        self.upper = m;
+        self.lower = m;
+        self.at = at;
+        self.rescans += 1;
+    }
+}
+
+/// The index and magnitude of the largest |v| of a slice of finite values ((0, 0) when empty).
+fn abs_argmax(v: &[f64]) -> (usize, f64) {
+    let m = abs_max(v);
+    (v.iter().position(|x| x.abs() == m).unwrap_or(0), m)
 }
 
 /// max |v| of a slice of finite values (0 for an empty one), with independent accumulators so
@@ -664,8 +706,8 @@ pub struct Segment {
     c: Vec<f64>,
     e: Vec<f64>,
     resp: UnitResponses,
-    c_max: MaxTracker,
-    e_max: MaxTracker,
+    c_scale: SignScale,
+    e_scale: SignScale,
     params: SegmentParams,
     bounds: Option<(Vec<f64>, Vec<f64>)>,
     limited: bool,
@@ -694,8 +736,8 @@ impl Segment {
             x: spline.x().to_vec(),
             y: spline.y().to_vec(),
             e: vec![0.0; n],
-            c_max: MaxTracker::new(&c),
-            e_max: MaxTracker::new(&[]),
+            c_scale: SignScale::new(&c),
+            e_scale: SignScale::new(&[]),
             c,
             resp,
             params: SegmentParams::DEFAULT,
@@ -703,7 +745,7 @@ impl Segment {
             limited: false,
         };
         seg.refresh_e(1, n - 2);
-        seg.e_max = MaxTracker::new(&seg.e);
+        seg.e_scale = SignScale::new(&seg.e);
         Ok(seg)
     }
 
@@ -791,12 +833,12 @@ impl Segment {
 
     /// HAN's `Infl_num = #{i : c_i c_{i+1} < 0}` with the zero tolerance of §1.7.0.
     pub fn inflection_count(&self) -> usize {
-        count_strict_changes(&self.c, self.c_max.max())
+        count_strict_changes(&self.c, abs_max(&self.c))
     }
 
     /// HAN's `Vib_num = #{i : e_i e_{i+1} < 0}` with the zero tolerance of §1.7.0.
     pub fn vibration_count(&self) -> usize {
-        count_strict_changes(&self.e, self.e_max.max())
+        count_strict_changes(&self.e, abs_max(&self.e))
     }
 
     /// Run `iterations` iterations of [`Procedure::ITERATION`], calling `on_move` for every
@@ -899,30 +941,30 @@ impl Segment {
 
     // --- sign tests --------------------------------------------------------------------------
 
+    fn e_sign(&mut self, i: usize) -> i8 {
+        self.e_scale.sign(&self.e, i)
+    }
+
+    fn c_sign(&mut self, i: usize) -> i8 {
+        self.c_scale.sign(&self.c, i)
+    }
+
     /// `sgn0(u)·sgn0(v) < 0` on e.
-    fn e_opp(&self, i: usize, k: usize) -> bool {
-        let s = self.e_max.max();
-        sgn0(self.e[i], s) * sgn0(self.e[k], s) < 0
+    fn e_opp(&mut self, i: usize, k: usize) -> bool {
+        self.e_sign(i) * self.e_sign(k) < 0
     }
 
     /// `sgn0(u)·sgn0(v) > 0` on e.
-    fn e_same(&self, i: usize, k: usize) -> bool {
-        let s = self.e_max.max();
-        sgn0(self.e[i], s) * sgn0(self.e[k], s) > 0
+    fn e_same(&mut self, i: usize, k: usize) -> bool {
+        self.e_sign(i) * self.e_sign(k) > 0
     }
 
-    fn c_opp(&self, i: usize, k: usize) -> bool {
-        let s = self.c_max.max();
-        sgn0(self.c[i], s) * sgn0(self.c[k], s) < 0
+    fn c_opp(&mut self, i: usize, k: usize) -> bool {
+        self.c_sign(i) * self.c_sign(k) < 0
     }
 
-    fn c_same(&self, i: usize, k: usize) -> bool {
-        let s = self.c_max.max();
-        sgn0(self.c[i], s) * sgn0(self.c[k], s) > 0
-    }
-
-    fn c_sign(&self, i: usize) -> i8 {
-        sgn0(self.c[i], self.c_max.max())
+    fn c_same(&mut self, i: usize, k: usize) -> bool {
+        self.c_sign(i) * self.c_sign(k) > 0
     }
 
     /// The α rule: a fraction of whichever neighbour value has the smaller magnitude (left on
@@ -1173,25 +1215,41 @@ impl Segment {
             return None;
         }
         self.y[start..start + len].copy_from_slice(&targets[..len]);
-        let (lo, hi) = self.resp.add_columns(start, &applied[..len], &mut self.c);
-        self.c_max.update(&self.c, lo, hi);
-        let (elo, ehi) = (lo.saturating_sub(1).max(1), (hi + 1).min(self.len() - 2));
-        self.refresh_e(elo, ehi);
-        self.e_max.update(&self.e, elo, ehi);
+        let w = self.resp.add_columns(start, &applied[..len], &mut self.c);
+        self.c_scale.wrote(&self.c, w);
+        let (elo, ehi) = (
+            w.lo.saturating_sub(1).max(1),
+            (w.hi + 1).min(self.len() - 2),
+        );
+        let we = self.refresh_e(elo, ehi);
+        self.e_scale.wrote(&self.e, we);
         Some((scale, applied))
     }
 
     /// Recompute `e_i = s_i − s_{i−1}`, `s_i = (c_{i+1} − c_i)/h_i`, from c for `lo..=hi`
-    /// (interior indices); each slope is computed once.
-    fn refresh_e(&mut self, lo: usize, hi: usize) {
+    /// (interior indices); each slope is computed once. Returns what changed.
+    fn refresh_e(&mut self, lo: usize, hi: usize) -> Changed {
         let h = &self.resp.h;
         let c = &self.c;
+        let mut w = Changed {
+            lo,
+            hi,
+            max: 0.0,
+            at: lo,
+        };
         let mut prev = (c[lo] - c[lo - 1]) / h[lo - 1];
         for (i, e) in self.e.iter_mut().enumerate().take(hi + 1).skip(lo) {
             let next = (c[i + 1] - c[i]) / h[i];
             *e = next - prev;
+            w.see(i, *e);
             prev = next;
         }
+        w
+    }
+
+    /// How often the sign tests needed a full rescan of c or e for their exact maximum.
+    pub fn rescans(&self) -> usize {
+        self.c_scale.rescans + self.e_scale.rescans
     }
 }
 
@@ -1795,36 +1853,56 @@ mod tests {
     use super::*;
 
     #[test]
-    fn max_tracker_tracks_updates() {
-        let mut v = vec![1.0, -5.0, 2.0, 0.5, 3.0];
-        let mut t = MaxTracker::new(&v);
-        assert_eq!(t.max(), 5.0);
-        v[1] = 0.1;
-        t.update(&v, 1, 1);
-        assert_eq!(t.max(), 3.0);
-        v[3] = -7.0;
-        v[4] = 0.0;
-        t.update(&v, 3, 4);
-        assert_eq!(t.max(), 7.0);
-        let one = MaxTracker::new(&[-2.0]);
-        assert_eq!(one.max(), 2.0);
-        // Many blocks, random updates, against a full scan.
-        let n = 5 * MAX_BLOCK + 17;
-        let mut v: Vec<f64> = (0..n).map(|i| ((i * 7919) % 1000) as f64 - 500.0).collect();
-        let mut t = MaxTracker::new(&v);
+    fn sign_scale_agrees_with_the_exact_maximum() {
+        // Random local rewrites, some to values right at ZERO_REL times the maximum: every
+        // sign equals sgn0 with the exact maximum, and rescans stay rare.
+        let n = 300;
         let mut state = 12345_u64;
-        for _ in 0..2000 {
+        let mut next = move || {
             state = state
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
-            let lo = (state >> 33) as usize % n;
-            let hi = (lo + (state >> 20) as usize % 70).min(n - 1);
-            for (k, x) in v[lo..=hi].iter_mut().enumerate() {
-                *x = ((state >> (k % 30)) % 2000) as f64 * 0.37 - 400.0;
+            state >> 11
+        };
+        let mut v: Vec<f64> = (0..n).map(|_| (next() % 2000) as f64 - 1000.0).collect();
+        let mut sc = SignScale::new(&v);
+        let mut checks = 0;
+        for round in 0..5000 {
+            let lo = next() as usize % n;
+            let hi = (lo + next() as usize % 20).min(n - 1);
+            let exact_before = abs_max(&v);
+            let mut w = Changed {
+                lo,
+                hi,
+                max: 0.0,
+                at: lo,
+            };
+            for i in lo..=hi {
+                let r = next();
+                v[i] = match r % 5 {
+                    0 => 0.0,
+                    1 => ZERO_REL * exact_before * if r % 2 == 0 { 1.0 } else { -1.0 },
+                    2 => ZERO_REL * exact_before * 1.5,
+                    _ => ((r >> 8) % 2000) as f64 * 0.37 * (1.0 + (round % 7) as f64) - 400.0,
+                };
+                w.see(i, v[i]);
             }
-            t.update(&v, lo, hi);
-            assert_eq!(t.max(), v.iter().fold(0.0_f64, |m, x| m.max(x.abs())));
+            sc.wrote(&v, w);
+            let exact = abs_max(&v);
+            for _ in 0..5 {
+                let i = next() as usize % n;
+                assert_eq!(
+                    sc.sign(&v, i),
+                    sgn0(v[i], exact),
+                    "round {round}, index {i}"
+                );
+                checks += 1;
+            }
+            assert!(sc.lower <= exact && exact <= sc.upper);
         }
+        assert!(sc.rescans < checks / 2, "{} rescans", sc.rescans);
+        let mut zeros = SignScale::new(&[0.0, 0.0]);
+        assert_eq!(zeros.sign(&[0.0, 0.0], 1), 0);
     }
 
     #[test]
