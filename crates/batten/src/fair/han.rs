@@ -157,6 +157,9 @@ pub struct UnitResponses {
     diag: Vec<f64>,
     left: Vec<f64>,
     right: Vec<f64>,
+    /// `ẽ_{j−1}^j, ẽ_j^j, ẽ_{j+1}^j` per column j (0 outside the interior): the entries the
+    /// coarse cases use, computed once.
+    e_near: Vec<[f64; 3]>,
 }
 
 impl UnitResponses {
@@ -207,14 +210,25 @@ impl UnitResponses {
                 d
             };
         }
-        Ok(UnitResponses {
+        let mut resp = UnitResponses {
             h,
             a,
             a_star,
             diag,
             left,
             right,
-        })
+            e_near: Vec::new(),
+        };
+        let mut e_near = vec![[0.0; 3]; n];
+        for (j, near) in e_near.iter_mut().enumerate().take(n - 1).skip(1) {
+            *near = [
+                resp.e_walk(j - 1, j),
+                resp.e_walk(j, j),
+                resp.e_walk(j + 1, j),
+            ];
+        }
+        resp.e_near = e_near;
+        Ok(resp)
     }
 
     /// Number of points n.
@@ -271,7 +285,15 @@ impl UnitResponses {
             j >= 1 && j + 1 < n && i < n,
             "unit response ({i}, {j}) out of range (n = {n})"
         );
-        if i == 0 || i == n - 1 {
+        if i + 1 >= j && i <= j + 1 {
+            return self.e_near[j][i + 1 - j];
+        }
+        self.e_walk(i, j)
+    }
+
+    /// `ẽ_i^j` from the column entries (for valid indices).
+    fn e_walk(&self, i: usize, j: usize) -> f64 {
+        if i == 0 || i == self.len() - 1 {
             return 0.0;
         }
         let (cm, c0, cp) = (self.c(i - 1, j), self.c(i, j), self.c(i + 1, j));
@@ -339,15 +361,9 @@ impl UnitResponses {
             *slot = s;
             big = big.max(s.abs());
         }
-        let mut changed = Changed {
-            lo,
-            hi,
-            max: 0.0,
-            at: lo,
-        };
-        for ((k, ci), d) in c[lo..=hi].iter_mut().enumerate().zip(&core[..width]) {
+        let (mut first, mut last) = (lo, hi);
+        for (ci, d) in c[lo..=hi].iter_mut().zip(&core[..width]) {
             *ci += d;
-            changed.see(lo + k, *ci);
         }
         let cut = RESPONSE_CUTOFF_REL * big;
         // Left of the moved points every column obeys c̃_i = −a_i c̃_{i+1}, so the sum does.
@@ -360,8 +376,7 @@ impl UnitResponses {
                 break;
             }
             c[i] += d;
-            changed.see(i, c[i]);
-            changed.lo = i;
+            first = i;
         }
         let mut d = core[width - 1];
         let mut i = hi;
@@ -372,15 +387,14 @@ impl UnitResponses {
                 break;
             }
             c[i] += d;
-            changed.see(i, c[i]);
-            changed.hi = i;
+            last = i;
         }
-        changed
+        Changed::of(c, first, last)
     }
 }
 
 /// The entries of an array that a local update rewrote: `lo..=hi`, and the largest new
-/// magnitude among them, `max = |v[at]|`.
+/// magnitude among them.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Changed {
     /// First rewritten index.
@@ -389,16 +403,15 @@ pub struct Changed {
     pub hi: usize,
     /// Largest |v_i| on `lo..=hi` after the update.
     pub max: f64,
-    /// An index where it is reached.
-    pub at: usize,
 }
 
 impl Changed {
-    fn see(&mut self, i: usize, v: f64) {
-        let a = v.abs();
-        if a > self.max {
-            self.max = a;
-            self.at = i;
+    /// The entries `lo..=hi` of `values`, rewritten.
+    fn of(values: &[f64], lo: usize, hi: usize) -> Changed {
+        Changed {
+            lo,
+            hi,
+            max: abs_max(&values[lo..=hi]),
         }
     }
 }
@@ -444,7 +457,7 @@ impl SignScale {
         }
         if w.max > self.lower {
             self.lower = w.max;
-            self.at = w.at;
+            self.at = w.lo + abs_argmax(&values[w.lo..=w.hi]).0;
         }
     }
 
@@ -1229,22 +1242,16 @@ impl Segment {
     /// Recompute `e_i = s_i − s_{i−1}`, `s_i = (c_{i+1} − c_i)/h_i`, from c for `lo..=hi`
     /// (interior indices); each slope is computed once. Returns what changed.
     fn refresh_e(&mut self, lo: usize, hi: usize) -> Changed {
-        let h = &self.resp.h;
-        let c = &self.c;
-        let mut w = Changed {
-            lo,
-            hi,
-            max: 0.0,
-            at: lo,
-        };
-        let mut prev = (c[lo] - c[lo - 1]) / h[lo - 1];
-        for (i, e) in self.e.iter_mut().enumerate().take(hi + 1).skip(lo) {
-            let next = (c[i + 1] - c[i]) / h[i];
-            *e = next - prev;
-            w.see(i, *e);
+        let c = &self.c[lo - 1..=hi + 1];
+        let h = &self.resp.h[lo - 1..=hi];
+        let e = &mut self.e[lo..=hi];
+        let mut prev = (c[1] - c[0]) / h[0];
+        for (k, ek) in e.iter_mut().enumerate() {
+            let next = (c[k + 2] - c[k + 1]) / h[k + 1];
+            *ek = next - prev;
             prev = next;
         }
-        w
+        Changed::of(&self.e, lo, hi)
     }
 
     /// How often the sign tests needed a full rescan of c or e for their exact maximum.
@@ -1871,12 +1878,6 @@ mod tests {
             let lo = next() as usize % n;
             let hi = (lo + next() as usize % 20).min(n - 1);
             let exact_before = abs_max(&v);
-            let mut w = Changed {
-                lo,
-                hi,
-                max: 0.0,
-                at: lo,
-            };
             for i in lo..=hi {
                 let r = next();
                 v[i] = match r % 5 {
@@ -1885,9 +1886,8 @@ mod tests {
                     2 => ZERO_REL * exact_before * 1.5,
                     _ => ((r >> 8) % 2000) as f64 * 0.37 * (1.0 + (round % 7) as f64) - 400.0,
                 };
-                w.see(i, v[i]);
             }
-            sc.wrote(&v, w);
+            sc.wrote(&v, Changed::of(&v, lo, hi));
             let exact = abs_max(&v);
             for _ in 0..5 {
                 let i = next() as usize % n;
