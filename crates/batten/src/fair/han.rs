@@ -44,13 +44,15 @@
 //! adding the response columns (eq 13) — the summed column of a move obeys the same
 //! recurrences outside the moved points, so it is walked outward once and cut off when it
 //! falls below [`RESPONSE_CUTOFF_REL`] of its largest entry (at most ~57 steps since each step
-//! at least halves it, ~30 on a uniform grid). `e` is recomputed from `c` on the changed range,
-//! and the maxima used by the sign tests are kept as per-block maxima (blocks of 32) under a
-//! small max-tree, refreshed on that range. A move therefore costs O(57 + log n) at worst (the
-//! climb usually stops after a level or two) and a sweep O(n), with no re-solve of the spline.
-//! Measured (release, one segment of a noisy sine, shared machine): 10⁵ points ≈ 1 s, 10⁶
-//! points 13–18 s for the default 3 passes × 10 iterations, about 1.5 million moves per
-//! iteration at 10⁶.
+//! at least halves it, ~30 on a uniform grid). `e` is recomputed from `c` on the changed range.
+//! The sign tests need max|c| and max|e| only to tell rounding residue from real values: an
+//! upper bound (raised by every written value) and a lower bound (one tracked entry) decide
+//! every test except one on a value between `ZERO_REL·lower` and `ZERO_REL·upper`, which
+//! rescans for the exact maximum, so the tests are exactly those of the spec. A move
+//! therefore costs O(57) at worst and a sweep O(n), with no re-solve of the spline.
+//! Measured (release, `benches/han.rs`, the spiral with a 1 % wobble): see `BENCHMARKS.md`;
+//! about 0.35 s for 10⁵ points and 4 s for 10⁶ with the default 3 passes × 10 iterations,
+//! some 17 million moves at 10⁶.
 //!
 //! # Common options
 //!
@@ -1467,9 +1469,10 @@ static PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         name: "max_turn",
-        default: "pi",
-        doc: "turning range of a segment in radians, in (0, π]; accepts pi and pi/N; \
-              pi/2 is recommended (segments stay away from vertical slopes)",
+        default: "pi/2",
+        doc: "turning range of a segment in radians, in (0, π]; accepts pi and pi/N; the \
+              paper's value is pi; pi/2 (the spec's recommendation) keeps segments away from \
+              vertical slopes",
     },
     ParamSpec {
         name: "alpha_factor",
