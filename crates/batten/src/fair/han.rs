@@ -51,7 +51,7 @@
 //! rescans for the exact maximum, so the tests are exactly those of the spec. A move
 //! therefore costs O(57) at worst and a sweep O(n), with no re-solve of the spline.
 //! Measured (release, `benches/han.rs`, the spiral with a 1 % wobble): see `BENCHMARKS.md`;
-//! about 0.35 s for 10⁵ points and 4 s for 10⁶ with the default 3 passes × 10 iterations,
+//! about 0.35 s for 10⁵ points and 3.5 s for 10⁶ with the default 3 passes × 10 iterations,
 //! some 17 million moves at 10⁶.
 //!
 //! # Common options
@@ -1254,11 +1254,6 @@ impl Segment {
             prev = next;
         }
         Changed::of(&self.e, lo, hi)
-    }
-
-    /// How often the sign tests needed a full rescan of c or e for their exact maximum.
-    pub fn rescans(&self) -> usize {
-        self.c_scale.rescans + self.e_scale.rescans
     }
 }
 
