@@ -939,6 +939,30 @@ fn steep_segments_are_re_partitioned_with_the_papers_max_turn() {
 }
 
 #[test]
+fn result_does_not_depend_on_the_number_of_threads() {
+    // The segments of a pass are faired in parallel; blending and the report follow the curve's
+    // order, so one thread and several give the same bits.
+    let pts = random_curve(4242, 400, false);
+    let input = PointSeq::open(pts).unwrap();
+    let o = FairOptions::default().with_param("max_turn", "pi/4");
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| fair::fair("han", &input, &o).unwrap())
+    };
+    let (one, four) = (run(1), run(4));
+    assert!(han::partition(input.points(), PI / 4.0, 5).unwrap().len() > 3);
+    assert_eq!(one.points, four.points);
+    assert_eq!(one.report.moves.len(), four.report.moves.len());
+    for (a, b) in one.report.moves.iter().zip(&four.report.moves) {
+        assert_eq!((a.index, a.distance), (b.index, b.distance));
+    }
+    assert_eq!(one.report.notes, four.report.notes);
+}
+
+#[test]
 fn method_is_registered_after_mst() {
     let names: Vec<&str> = fair::methods().iter().map(|m| m.name()).collect();
     let han_at = names

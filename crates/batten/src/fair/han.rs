@@ -80,6 +80,8 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::ops::Range;
 
+use rayon::prelude::*;
+
 use super::{FairMethod, FairStatus, HistoryRow, Move, Outcome, ParamSpec, clamp_to_tolerance};
 use crate::analysis::{ZERO_REL, count_sign_changes, sgn0};
 use crate::error::{Error, Result};
@@ -1551,7 +1553,21 @@ impl RunLog {
             });
         }
     }
+
+    /// Append the log of a later piece of work, keeping the first [`MAX_RECORDED_MOVES`]
+    /// moves, as if it had been recorded here.
+    fn append(&mut self, later: RunLog) {
+        let room = MAX_RECORDED_MOVES.saturating_sub(self.moves.len());
+        self.moves.extend(later.moves.into_iter().take(room));
+        self.total_moves += later.total_moves;
+        self.limited |= later.limited;
+        self.skipped.extend(later.skipped);
+        self.refined += later.refined;
+    }
 }
+
+/// Maps a position in a sequence being faired to the caller's point index.
+type IndexMap<'a> = &'a (dyn Fn(usize) -> usize + Sync);
 
 /// Shared inputs of the passes.
 struct PassCtx<'a> {
@@ -1569,28 +1585,40 @@ fn open_pass(
     orig: &[Point],
     max_turn: f64,
     ctx: &PassCtx<'_>,
-    index_of: &dyn Fn(usize) -> usize,
+    index_of: IndexMap<'_>,
     log: &mut RunLog,
 ) -> Result<usize> {
     if cur.len() < MIN_SEGMENT_POINTS {
         return Ok(0);
     }
     let spans = partition(cur, max_turn, ctx.params.overlap)?;
+    // The segments of a pass are faired independently from the same points, so in parallel;
+    // blending and the logs then follow the curve's order, so the result does not depend on
+    // the number of threads.
+    let faired: Vec<Result<(Vec<Point>, usize, RunLog)>> = spans
+        .par_iter()
+        .map(|span| {
+            let range = span.start..span.end + 1;
+            let sub_index = |m: usize| index_of(span.start + m);
+            let mut sub_log = RunLog::default();
+            let (pts, m) = fair_span(
+                &cur[range.clone()],
+                &orig[range],
+                span,
+                max_turn,
+                ctx,
+                &sub_index,
+                &mut sub_log,
+            )?;
+            Ok((pts, m, sub_log))
+        })
+        .collect();
     let mut out = cur.to_vec();
     let mut moves = 0;
     let mut covered_to: Option<usize> = None;
-    for span in &spans {
-        let range = span.start..span.end + 1;
-        let sub_index = |m: usize| index_of(span.start + m);
-        let (faired, m) = fair_span(
-            &cur[range.clone()],
-            &orig[range],
-            span,
-            max_turn,
-            ctx,
-            &sub_index,
-            log,
-        )?;
+    for (span, result) in spans.iter().zip(faired) {
+        let (faired, m, sub_log) = result?;
+        log.append(sub_log);
         moves += m;
         // Blend the points shared with what is already there (spec §1.8.6): w_q = q/(K+1).
         let shared = covered_to.map_or(0, |c| (c + 1).saturating_sub(span.start));
@@ -1620,7 +1648,7 @@ fn fair_span(
     span: &Span,
     max_turn: f64,
     ctx: &PassCtx<'_>,
-    index_of: &dyn Fn(usize) -> usize,
+    index_of: IndexMap<'_>,
     log: &mut RunLog,
 ) -> Result<(Vec<Point>, usize)> {
     if pts.len() < MIN_SEGMENT_POINTS {
