@@ -256,6 +256,13 @@ impl UnitResponses {
             j >= 1 && j + 1 < n && i < n,
             "unit response ({i}, {j}) out of range (n = {n})"
         );
+        self.c_at(i, j)
+    }
+
+    /// [`UnitResponses::c`] for indices the caller has checked (the hot path).
+    #[inline]
+    fn c_at(&self, i: usize, j: usize) -> f64 {
+        debug_assert!(j >= 1 && j + 1 < self.len() && i < self.len());
         if i == j {
             self.diag[j]
         } else if i + 1 == j {
@@ -289,6 +296,13 @@ impl UnitResponses {
             j >= 1 && j + 1 < n && i < n,
             "unit response ({i}, {j}) out of range (n = {n})"
         );
+        self.e_at(i, j)
+    }
+
+    /// [`UnitResponses::e`] for indices the caller has checked (the hot path).
+    #[inline]
+    fn e_at(&self, i: usize, j: usize) -> f64 {
+        debug_assert!(j >= 1 && j + 1 < self.len() && i < self.len());
         if i + 1 >= j && i <= j + 1 {
             return self.e_near[j][i + 1 - j];
         }
@@ -300,7 +314,7 @@ impl UnitResponses {
         if i == 0 || i == self.len() - 1 {
             return 0.0;
         }
-        let (cm, c0, cp) = (self.c(i - 1, j), self.c(i, j), self.c(i + 1, j));
+        let (cm, c0, cp) = (self.c_at(i - 1, j), self.c_at(i, j), self.c_at(i + 1, j));
         (cp - c0) / self.h[i] - (c0 - cm) / self.h[i - 1]
     }
 
@@ -360,7 +374,7 @@ impl UnitResponses {
         for (slot, i) in core.iter_mut().zip(lo..=hi) {
             let mut s = 0.0;
             for (k, g) in gammas.iter().enumerate() {
-                s += g * self.c(i, start + k);
+                s += g * self.c_at(i, start + k);
             }
             *slot = s;
             big = big.max(s.abs());
@@ -1005,8 +1019,8 @@ impl Segment {
                 continue;
             }
             let r = &self.resp;
-            let p = r.e(i, i) - r.e(i, i + 1);
-            let q = r.e(i + 1, i) - r.e(i + 1, i + 1);
+            let p = r.e_at(i, i) - r.e_at(i, i + 1);
+            let q = r.e_at(i + 1, i) - r.e_at(i + 1, i + 1);
             let s1 = -self.e[i] / p;
             let s2 = -self.e[i + 1] / q;
             let sigma = if s1.abs() <= s2.abs() { s1 } else { s2 };
@@ -1018,18 +1032,18 @@ impl Segment {
         let n = self.len();
         for i in 2..=n - 3 {
             if self.e_opp(i, i - 1) && self.e_opp(i, i + 1) {
-                let g = -self.e[i] / self.resp.e(i, i);
+                let g = -self.e[i] / self.resp.e_at(i, i);
                 self.apply(MoveTag::C2, i, i, &[g], on_move);
             }
         }
         // End rules: the isolated sign has two neighbours on the only available side.
         if self.e_opp(1, 2) && self.e_opp(1, 3) {
-            let g = -self.e[1] / self.resp.e(1, 1);
+            let g = -self.e[1] / self.resp.e_at(1, 1);
             self.apply(MoveTag::C2End, 1, 1, &[g], on_move);
         }
         let m = n - 2;
         if self.e_opp(m, m - 1) && self.e_opp(m, m - 2) {
-            let g = -self.e[m] / self.resp.e(m, m);
+            let g = -self.e[m] / self.resp.e_at(m, m);
             self.apply(MoveTag::C2End, m, m, &[g], on_move);
         }
     }
@@ -1038,10 +1052,10 @@ impl Segment {
     fn zero_two_e(&self, i: usize, k: usize) -> Option<(f64, f64)> {
         let r = &self.resp;
         solve2(
-            r.e(i, i),
-            r.e(i, k),
-            r.e(k, i),
-            r.e(k, k),
+            r.e_at(i, i),
+            r.e_at(i, k),
+            r.e_at(k, i),
+            r.e_at(k, k),
             -self.e[i],
             -self.e[k],
         )
@@ -1089,7 +1103,7 @@ impl Segment {
             }
             let (sl, sr) = (self.c_sign(i - 1), self.c_sign(i + 1));
             let r = &self.resp;
-            let k = r.c(i, i) - lf * (r.c(i, i - 1) + r.c(i, i + 1));
+            let k = r.c_at(i, i) - lf * (r.c_at(i, i - 1) + r.c_at(i, i + 1));
             let sigma = -self.c[i] / k;
             self.apply(
                 MoveTag::F1,
@@ -1116,10 +1130,10 @@ impl Segment {
         let lf = self.params.lambda_fine;
         let r = &self.resp;
         solve2(
-            r.c(i, i) - lf * r.c(i, i - 1),
-            r.c(i, i + 1) - lf * r.c(i, i + 2),
-            r.c(i + 1, i) - lf * r.c(i + 1, i - 1),
-            r.c(i + 1, i + 1) - lf * r.c(i + 1, i + 2),
+            r.c_at(i, i) - lf * r.c_at(i, i - 1),
+            r.c_at(i, i + 1) - lf * r.c_at(i, i + 2),
+            r.c_at(i + 1, i) - lf * r.c_at(i + 1, i - 1),
+            r.c_at(i + 1, i + 1) - lf * r.c_at(i + 1, i + 2),
             alpha - self.c[i],
             alpha - self.c[i + 1],
         )
@@ -1150,12 +1164,12 @@ impl Segment {
             }
         }
         if self.c_opp(0, 2) && self.c_opp(0, 3) {
-            let g = -self.c[1] / self.resp.c(1, 1);
+            let g = -self.c[1] / self.resp.c_at(1, 1);
             self.apply(MoveTag::F2End, 1, 1, &[g], on_move);
         }
         let m = n - 1;
         if self.c_opp(m, m - 2) && self.c_opp(m, m - 3) {
-            let g = -self.c[m - 1] / self.resp.c(m - 1, m - 1);
+            let g = -self.c[m - 1] / self.resp.c_at(m - 1, m - 1);
             self.apply(MoveTag::F2End, m - 1, m - 1, &[g], on_move);
         }
     }
