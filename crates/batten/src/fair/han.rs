@@ -156,6 +156,7 @@ const TOLERANCE_SAFETY_ULPS: f64 = 16.0;
 #[derive(Clone, Debug, PartialEq)]
 pub struct UnitResponses {
     h: Vec<f64>,
+    inv_h: Vec<f64>,
     /// Forward sweep `a`, length n − 1 (`a[0] = −1`).
     a: Vec<f64>,
     /// Backward sweep `a*`, length n; `a_star[0]` is unused (0).
@@ -217,6 +218,7 @@ impl UnitResponses {
             };
         }
         let mut resp = UnitResponses {
+            inv_h: h.iter().map(|v| 1.0 / v).collect(),
             h,
             a,
             a_star,
@@ -372,15 +374,25 @@ impl UnitResponses {
         // The summed column on lo..=hi, in a fixed order (bitwise c̃_0 = c̃_1 preserved).
         let mut core = [0.0_f64; 8];
         let width = hi - lo + 1;
-        let mut big = 0.0_f64;
-        for (slot, i) in core.iter_mut().zip(lo..=hi) {
-            let mut s = 0.0;
-            for (k, g) in gammas.iter().enumerate() {
-                s += g * self.c_at(i, start + k);
+        for (k, &g) in gammas.iter().enumerate() {
+            // Column j on lo..=hi, walked outward from j with the same products as `c_at`;
+            // every entry of `core` sums the columns in the order of `gammas`.
+            let j = start + k;
+            core[j - lo] += g * self.diag[j];
+            let mut v = self.left[j];
+            core[j - 1 - lo] += g * v;
+            for i in (lo..j - 1).rev() {
+                v *= -self.a[i];
+                core[i - lo] += g * v;
             }
-            *slot = s;
-            big = big.max(s.abs());
+            let mut v = self.right[j];
+            core[j + 1 - lo] += g * v;
+            for i in j + 2..=hi {
+                v *= -self.a_star[i];
+                core[i - lo] += g * v;
+            }
         }
+        let big = abs_max(&core[..width]);
         let (mut first, mut last) = (lo, hi);
         for (ci, d) in c[lo..=hi].iter_mut().zip(&core[..width]) {
             *ci += d;
@@ -482,6 +494,7 @@ impl SignScale {
     }
 
     /// `sgn0(values[i], max |values|)`.
+    #[inline]
     fn sign(&mut self, values: &[f64], i: usize) -> i8 {
         let v = values[i];
         let a = v.abs();
@@ -495,6 +508,7 @@ impl SignScale {
         sgn0(v, self.upper)
     }
 
+    #[cold]
     fn rescan(&mut self, values: &[f64]) {
         let (at, m) = abs_argmax(values);
         self.upper = m;
@@ -974,28 +988,34 @@ impl Segment {
 
     // --- sign tests --------------------------------------------------------------------------
 
+    #[inline]
     fn e_sign(&mut self, i: usize) -> i8 {
         self.e_scale.sign(&self.e, i)
     }
 
+    #[inline]
     fn c_sign(&mut self, i: usize) -> i8 {
         self.c_scale.sign(&self.c, i)
     }
 
     /// `sgn0(u)·sgn0(v) < 0` on e.
+    #[inline]
     fn e_opp(&mut self, i: usize, k: usize) -> bool {
         self.e_sign(i) * self.e_sign(k) < 0
     }
 
     /// `sgn0(u)·sgn0(v) > 0` on e.
+    #[inline]
     fn e_same(&mut self, i: usize, k: usize) -> bool {
         self.e_sign(i) * self.e_sign(k) > 0
     }
 
+    #[inline]
     fn c_opp(&mut self, i: usize, k: usize) -> bool {
         self.c_sign(i) * self.c_sign(k) < 0
     }
 
+    #[inline]
     fn c_same(&mut self, i: usize, k: usize) -> bool {
         self.c_sign(i) * self.c_sign(k) > 0
     }
@@ -1263,11 +1283,11 @@ impl Segment {
     /// (interior indices); each slope is computed once. Returns what changed.
     fn refresh_e(&mut self, lo: usize, hi: usize) -> Changed {
         let c = &self.c[lo - 1..=hi + 1];
-        let h = &self.resp.h[lo - 1..=hi];
+        let h = &self.resp.inv_h[lo - 1..=hi];
         let e = &mut self.e[lo..=hi];
-        let mut prev = (c[1] - c[0]) / h[0];
+        let mut prev = (c[1] - c[0]) * h[0];
         for (k, ek) in e.iter_mut().enumerate() {
-            let next = (c[k + 2] - c[k + 1]) / h[k + 1];
+            let next = (c[k + 2] - c[k + 1]) * h[k + 1];
             *ek = next - prev;
             prev = next;
         }
