@@ -69,10 +69,20 @@ pub(crate) fn arc_lengths_at_sorted(curve: &BSplineCurve, ts: &[f64]) -> Vec<f64
             if end <= pos {
                 break;
             }
-            s += gl.integrate(pos, end, |x| {
-                let d = curve.first_derivative(x);
-                d.length_squared().sqrt()
-            });
+            s += if curve.weights().is_some() {
+                gl.integrate(pos, end, |x| {
+                    curve.first_derivative(x).length_squared().sqrt()
+                })
+            } else {
+                // One span search per piece; the nodes are inside it.
+                let span = curve.find_span(0.5 * (pos + end));
+                gl.integrate(pos, end, |x| {
+                    curve
+                        .first_derivative_in_span(span, x)
+                        .length_squared()
+                        .sqrt()
+                })
+            };
             pos = end;
         }
         out.push(s);

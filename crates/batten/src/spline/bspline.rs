@@ -218,6 +218,46 @@ impl BSplineCurve {
         d
     }
 
+    /// `x'(t)` on span `k` (`u_k ≤ t ≤ u_{k+1}`, `u_k < u_{k+1}`) of a non-rational curve:
+    /// the derivative's control points `Q_i = p (P_i − P_{i−1}) / (u_{i+p} − u_i)` against the
+    /// degree-(p−1) basis (Piegl & Tiller eq 3.3 and A2.2). No span search and no basis
+    /// derivatives, for the many evaluations of arc-length quadrature.
+    ///
+    /// # Panics
+    /// In debug builds, for a rational curve or a span index out of range.
+    pub(crate) fn first_derivative_in_span(&self, k: usize, t: f64) -> Vec2 {
+        debug_assert!(self.weights.is_none(), "rational curves take the full path");
+        let p = self.degree;
+        if p == 0 {
+            return Vec2::ZERO;
+        }
+        let u = self.knots.as_slice();
+        let q = p - 1;
+        let mut n = [0.0; MAX_ORDER];
+        let mut left = [0.0; MAX_ORDER];
+        let mut right = [0.0; MAX_ORDER];
+        n[0] = 1.0;
+        for j in 1..=q {
+            left[j] = t - u[k + 1 - j];
+            right[j] = u[k + j] - t;
+            let mut saved = 0.0;
+            for r in 0..j {
+                let temp = n[r] / (right[r + 1] + left[j - r]);
+                n[r] = saved + right[r + 1] * temp;
+                saved = left[j - r] * temp;
+            }
+            n[j] = saved;
+        }
+        let mut d = Vec2::ZERO;
+        for (r, nr) in n.iter().enumerate().take(q + 1) {
+            let i = k - q + r;
+            let qi = (self.control_points[i] - self.control_points[i - 1])
+                * (p as f64 / (u[i + p] - u[i]));
+            d += qi * *nr;
+        }
+        d
+    }
+
     /// Position and up to three derivatives, evaluated on span `k`.
     fn derivs_in_span(&self, k: usize, t: f64) -> Derivatives {
         let p = self.degree;
@@ -419,5 +459,48 @@ impl Piecewise for BSplineCurve {
             }
         }
         v
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn first_derivative_in_span_matches_the_basis_derivatives() {
+        // Degrees 1..=5 on non-uniform clamped knots with a double interior knot: the
+        // derivative from the degree-(p−1) basis equals the one from basis derivatives, at
+        // the span ends too.
+        for p in 1..=5 {
+            let n_ctrl = p + 6;
+            let mut knots = vec![0.0; p + 1];
+            let inner = [0.3, 0.7, 0.7, 1.6, 2.0, 2.9];
+            knots.extend_from_slice(&inner[..n_ctrl - p - 1]);
+            knots.extend(std::iter::repeat_n(3.5, p + 1));
+            let pts: Vec<Point> = (0..n_ctrl)
+                .map(|i| {
+                    let x = i as f64;
+                    Point::new(x + 0.3 * (x * 1.7).sin(), (x * 0.9).cos() * (1.0 + 0.1 * x))
+                })
+                .collect();
+            let curve = BSplineCurve::try_new(p, KnotVector::new(knots), pts, None)
+                .unwrap_or_else(|e| panic!("degree {p}: {e}"));
+            let u = curve.knots().as_slice().to_vec();
+            for k in p..n_ctrl {
+                if u[k] == u[k + 1] {
+                    continue;
+                }
+                for f in [0.0, 0.13, 0.5, 0.91, 1.0] {
+                    let t = u[k] + f * (u[k + 1] - u[k]);
+                    let want = curve.derivs_in_span(k, t).d1;
+                    let got = curve.first_derivative_in_span(k, t);
+                    let err = (got - want).length();
+                    assert!(
+                        err <= 1e-12 * (1.0 + want.length()),
+                        "p {p}, span {k}, t {t}: {err}"
+                    );
+                }
+            }
+        }
     }
 }
