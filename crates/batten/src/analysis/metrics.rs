@@ -67,7 +67,7 @@ pub fn count_sign_changes(values: &[f64], cyclic: bool) -> usize {
 ///
 /// They are measured on the *analysis curve* of the points ([`analysis_curve`]): the C² cubic
 /// spline through them with chord-length parameters, not-a-knot ends for an open curve
-/// ([CHOICE]: it imposes no artificial zero curvature at the ends) and periodic for a closed one.
+/// (\[CHOICE\]: it imposes no artificial zero curvature at the ends) and periodic for a closed one.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FairnessMetrics {
     /// Number of points.

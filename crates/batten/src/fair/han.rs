@@ -21,7 +21,7 @@
 //! - eqs 14–15 at j = 2 and j = n−1: `ā_{j−1} = 0`, `ā*_{j+1} = 0` in the numerator and
 //!   `c̃_1^2 = c̃_2^2`, `c̃_n^{n−1} = c̃_{n−1}^{n−1}` (\[FIX\], §1.6);
 //! - `e_1 = e_n = 0` (flat ends, \[CHOICE\] §1.5); sign tests with `sgn0` and
-//!   [`ZERO_REL`](crate::analysis::ZERO_REL) `= 1e-12` relative to the largest |value| of the
+//!   [`ZERO_REL`] `= 1e-12` relative to the largest |value| of the
 //!   current array (\[CHOICE\] §1.7.0);
 //! - coarse case 2 end rule `e_2 e_3 < 0 ∧ e_2 e_4 < 0` and its mirror (\[CHOICE/FIX\] §1.7.1);
 //! - coarse case 3 end rule with `e_2 e_4 < 0`, `e_2 e_5 < 0` (\[FIX\] §1.7.1);
