@@ -1033,6 +1033,25 @@ fn fairs_a_noisy_sine_curve() {
 }
 
 #[test]
+fn moves_keep_the_tolerance_without_a_final_pull_back() {
+    // Every move is scaled back to the tolerance discs, so the final safety clamp has nothing
+    // to do: no point is reported as pulled back, even when most moves are limited.
+    for seed in 1..=5 {
+        let input = PointSeq::open(noisy_sine_curve(30, 0.03, seed)).unwrap();
+        for tol in [0.002, 0.01, 0.03] {
+            let out =
+                fair::fair("han", &input, &FairOptions::default().with_tolerance(tol)).unwrap();
+            assert!(out.report.max_displacement <= tol, "seed {seed}, {tol}");
+            assert!(
+                !out.report.notes.iter().any(|n| n.contains("pulled back")),
+                "seed {seed}, {tol}: {:?}",
+                out.report.notes
+            );
+        }
+    }
+}
+
+#[test]
 fn options_are_checked() {
     let input = PointSeq::open(noisy_sine_curve(20, 0.02, 1)).unwrap();
     for (k, v) in [

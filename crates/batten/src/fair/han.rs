@@ -1837,7 +1837,10 @@ impl FairMethod for Han {
             }
         }
         let mut notes = Vec::new();
-        if let Some(d) = tolerance {
+        // A safety net against the tolerance asked for. The moves already keep every point
+        // inside the slightly smaller `tolerance`, so clamping to that one would only move
+        // points that sit on its boundary by an ulp.
+        if let Some(d) = options.tolerance {
             let pulled = clamp_to_tolerance(orig, &mut cur, d);
             if pulled > 0 {
                 log.limited = true;
