@@ -6,9 +6,9 @@
 //! input's directory). Then each file is read, faired and written on its own: a file that
 //! fails is a row of the summary and a line on stderr, not the end of the batch.
 //!
-//! A parameter value (`--set p=2`) is checked by the method when it runs, so it is reported
-//! per file: the library cannot check one without data, and some ranges depend on the data
-//! (`control_points` at most the number of points). A file that fails writes nothing, and
+//! Parameter values (`--set p=2`) are among those first checks (`FairMethod::check_params`).
+//! Only the few ranges that depend on the data (`control_points` at most the number of
+//! points) are checked per file, when the method runs. A file that fails writes nothing, and
 //! does not remove what an earlier run wrote under its name: the summary tells which results
 //! are from this run.
 //!

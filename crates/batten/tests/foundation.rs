@@ -1409,3 +1409,43 @@ fn nearly_coincident_points() {
         Error::DuplicatePoint { index: 6 }
     );
 }
+
+/// Every parameter of every method is checked before any input is read: a value that is not
+/// one the parameter takes is refused by `check_options`, and the defaults pass.
+#[test]
+fn every_method_checks_its_parameter_values_up_front() {
+    use batten::fair::{self, FairOptions};
+    for m in fair::methods() {
+        fair::check_options(*m, false, &FairOptions::default())
+            .unwrap_or_else(|e| panic!("{}: defaults refused: {e}", m.name()));
+        for spec in m.parameters() {
+            let o = FairOptions::default().with_param(spec.name, "not-a-value");
+            match fair::check_options(*m, false, &o) {
+                Err(Error::InvalidParameter { name, .. }) => {
+                    assert_eq!(name, spec.name, "{}: wrong parameter named", m.name());
+                }
+                other => panic!(
+                    "{}: {}=not-a-value gave {other:?}, not an invalid-parameter error",
+                    m.name(),
+                    spec.name
+                ),
+            }
+            // The documented default is accepted.
+            let o = FairOptions::default().with_param(spec.name, spec.default);
+            assert!(
+                fair::check_options(*m, false, &o).is_ok(),
+                "{}: {}={} (the default) refused",
+                m.name(),
+                spec.name,
+                spec.default
+            );
+        }
+    }
+    // Range checks happen up front too.
+    let mst = fair::method("mst").unwrap();
+    let o = FairOptions::default().with_param("p", "2");
+    assert!(matches!(
+        fair::check_options(mst, false, &o),
+        Err(Error::InvalidParameter { .. })
+    ));
+}

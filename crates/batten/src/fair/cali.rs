@@ -150,6 +150,20 @@ static PARAMS: &[ParamSpec] = &[
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Cali;
 
+/// `tau`, `lambda_tol` and `degree`, checked.
+fn cali_params(options: &FairOptions) -> Result<(f64, f64, usize)> {
+    let tau = options.param_f64_in("tau", DEFAULT_TAU, 0.0, 1.0)?;
+    if tau <= 0.0 {
+        return Err(Error::InvalidParameter {
+            name: "tau".into(),
+            reason: "must be positive (no move can make the GFI negative)".into(),
+        });
+    }
+    let lambda_tol = options.param_f64_in("lambda_tol", DEFAULT_LAMBDA_TOL, MIN_LAMBDA_TOL, 0.5)?;
+    let degree = options.param_usize_in("degree", DEFAULT_DEGREE, 2, MAX_ORDER - 1)?;
+    Ok((tau, lambda_tol, degree))
+}
+
 impl FairMethod for Cali {
     fn name(&self) -> &'static str {
         "cali"
@@ -168,22 +182,17 @@ impl FairMethod for Cali {
         false
     }
 
+    fn check_params(&self, options: &FairOptions) -> Result<()> {
+        cali_params(options).map(|_| ())
+    }
+
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
         if input.is_closed() {
             return Err(Error::ClosedUnsupported {
                 method: self.name().to_string(),
             });
         }
-        let tau = options.param_f64_in("tau", DEFAULT_TAU, 0.0, 1.0)?;
-        if tau <= 0.0 {
-            return Err(Error::InvalidParameter {
-                name: "tau".into(),
-                reason: "must be positive (no move can make the GFI negative)".into(),
-            });
-        }
-        let lambda_tol =
-            options.param_f64_in("lambda_tol", DEFAULT_LAMBDA_TOL, MIN_LAMBDA_TOL, 0.5)?;
-        let degree = options.param_usize_in("degree", DEFAULT_DEGREE, 2, MAX_ORDER - 1)?;
+        let (tau, lambda_tol, degree) = cali_params(options)?;
         let points = input.points();
         let settings = Settings {
             tau,

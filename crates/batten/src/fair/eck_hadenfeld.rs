@@ -471,6 +471,11 @@ impl FairMethod for EckHadenfeld {
         false
     }
 
+    fn check_params(&self, options: &FairOptions) -> Result<()> {
+        local::check_fit_params(options)?;
+        order_and_tabu(options).map(|_| ())
+    }
+
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
         let fitted = local::fit_input(input, options)?;
         run_fitted(fitted, input, options)
@@ -489,6 +494,14 @@ impl FairMethod for EckHadenfeld {
     }
 }
 
+/// The `order` and `tabu` parameters, checked.
+fn order_and_tabu(options: &FairOptions) -> Result<(usize, usize)> {
+    Ok((
+        options.param_usize_in("order", DEFAULT_ORDER, 2, 3)?,
+        options.param_usize_in("tabu", DEFAULT_TABU_LENGTH, 0, 1000)?,
+    ))
+}
+
 /// The method on a fitted (or given) B-spline; `input` holds the points the output is
 /// compared with.
 fn run_fitted(
@@ -496,10 +509,11 @@ fn run_fitted(
     input: &PointSeq,
     options: &FairOptions,
 ) -> Result<Outcome> {
+    let (order, tabu_length) = order_and_tabu(options)?;
     let params = EckHadenfeldParams {
-        order: options.param_usize_in("order", DEFAULT_ORDER, 2, 3)?,
+        order,
         tolerance: Some(fitted.delta),
-        tabu_length: options.param_usize_in("tabu", DEFAULT_TABU_LENGTH, 0, 1000)?,
+        tabu_length,
         max_iterations: options.iterations_or(DEFAULT_MAX_ITERATIONS),
         min_rel_decrease: DEFAULT_MIN_REL_DECREASE,
         free_ends: fitted.free_ends,

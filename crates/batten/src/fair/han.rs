@@ -1783,6 +1783,10 @@ impl FairMethod for Han {
         true
     }
 
+    fn check_params(&self, options: &FairOptions) -> Result<()> {
+        HanParams::from_options(options).map(|_| ())
+    }
+
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
         let params = HanParams::from_options(options)?;
         let orig = input.points();

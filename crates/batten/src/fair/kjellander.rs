@@ -544,9 +544,13 @@ pub(super) enum Threshold {
 }
 
 impl Threshold {
-    /// Read the `threshold` and `epsilon` method parameters.
+    /// Read the `threshold` and `epsilon` method parameters (`epsilon=auto`, the documented
+    /// default, is the same as leaving it out).
     pub(super) fn from_options(options: &FairOptions) -> Result<Threshold> {
         let rel = options.param_f64_in("threshold", DEFAULT_THRESHOLD, 0.0, 1.0)?;
+        if options.params.get("epsilon").map(|s| s.trim()) == Some("auto") {
+            return Ok(Threshold::Relative(rel));
+        }
         match options.param_f64("epsilon")? {
             Some(e) if e < 0.0 => Err(Error::InvalidParameter {
                 name: "epsilon".into(),
@@ -1023,6 +1027,30 @@ pub(super) fn driven_parameters(
     p
 }
 
+/// The parameters of the point-only KP methods, checked without an input: the threshold and,
+/// on the chord-length spline, `reparametrize`.
+fn check_point_params(uniform: bool, options: &FairOptions) -> Result<()> {
+    Threshold::from_options(options)?;
+    if !uniform {
+        options.param_choice("reparametrize", "true", &["true", "false"])?;
+    }
+    Ok(())
+}
+
+/// The rule of the `energy` method, from its `mode` parameter.
+fn energy_rule(options: &FairOptions) -> Result<KpRule> {
+    Ok(
+        match options.param_choice(
+            "mode",
+            "position-and-tangent",
+            &["position-and-tangent", "position"],
+        )? {
+            "position" => KpRule::EnergyPositionOnly,
+            _ => KpRule::Energy,
+        },
+    )
+}
+
 /// Run one of the point-only KP methods.
 fn run_points(
     rule: KpRule,
@@ -1265,6 +1293,10 @@ impl FairMethod for Kjellander {
         true
     }
 
+    fn check_params(&self, options: &FairOptions) -> Result<()> {
+        check_point_params(true, options)
+    }
+
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
         run_points(KpRule::Kjellander, true, input, options)
     }
@@ -1285,6 +1317,10 @@ impl FairMethod for Poliakoff {
 
     fn supports_closed(&self) -> bool {
         true
+    }
+
+    fn check_params(&self, options: &FairOptions) -> Result<()> {
+        check_point_params(false, options)
     }
 
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
@@ -1314,16 +1350,13 @@ impl FairMethod for Energy {
         true
     }
 
+    fn check_params(&self, options: &FairOptions) -> Result<()> {
+        energy_rule(options)?;
+        check_point_params(false, options)
+    }
+
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
-        let rule = match options.param_choice(
-            "mode",
-            "position-and-tangent",
-            &["position-and-tangent", "position"],
-        )? {
-            "position" => KpRule::EnergyPositionOnly,
-            _ => KpRule::Energy,
-        };
-        run_points(rule, false, input, options)
+        run_points(energy_rule(options)?, false, input, options)
     }
 }
 

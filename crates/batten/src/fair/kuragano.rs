@@ -1614,6 +1614,10 @@ impl FairMethod for Kuragano {
         false
     }
 
+    fn check_params(&self, options: &FairOptions) -> Result<()> {
+        Kuragano::options(options)?.0.check()
+    }
+
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
         let points = input.points();
         let m = points.len();

@@ -423,6 +423,23 @@ pub(crate) const FIT_PARAMS: [ParamSpec; 3] = [
     },
 ];
 
+/// Check the values of [`FIT_PARAMS`] without an input: the degree, the control-point count
+/// against the degree (the bound by the number of points is checked by [`fit_input`]), and
+/// `free_ends`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`].
+pub(crate) fn check_fit_params(options: &FairOptions) -> Result<()> {
+    let degree = options.param_usize_in("degree", DEFAULT_FIT_DEGREE, 2, 5)?;
+    if !matches!(
+        options.params.get("control_points").map(|s| s.trim()),
+        None | Some("auto")
+    ) {
+        options.param_usize_in("control_points", degree + 1, degree + 1, usize::MAX)?;
+    }
+    param_bool(options, "free_ends", false).map(|_| ())
+}
+
 /// A boolean method parameter: `true/false`, `yes/no`, `1/0`, `on/off`.
 ///
 /// # Errors

@@ -74,6 +74,14 @@ pub trait FairMethod: Sync {
     fn parameters(&self) -> &'static [ParamSpec];
     /// Whether it can fair closed curves.
     fn supports_closed(&self) -> bool;
+    /// Check the values of the method's parameters in `options`, before any input is read
+    /// (their names are checked by [`check_options`]), so that a batch run refuses a bad
+    /// value before it starts. Only checks that need the input (e.g. a control-point count
+    /// against the number of points) are left to [`FairMethod::run`].
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`].
+    fn check_params(&self, options: &FairOptions) -> Result<()>;
     /// Run the method. `input` has passed validation; unknown parameters were rejected.
     ///
     /// # Errors
@@ -165,8 +173,8 @@ pub fn method(name: &str) -> Result<&'static dyn FairMethod> {
         })
 }
 
-/// Check `options` against what `method` accepts: known parameter names, a positive finite
-/// tolerance, closed-curve support.
+/// Check `options` against what `method` accepts: known parameter names and their values
+/// ([`FairMethod::check_params`]), a positive finite tolerance, closed-curve support.
 ///
 /// # Errors
 /// [`Error::UnknownOption`], [`Error::InvalidParameter`], [`Error::ClosedUnsupported`].
@@ -195,7 +203,7 @@ pub fn check_options(
             });
         }
     }
-    Ok(())
+    method.check_params(options)
 }
 
 /// Fair `input` with the method called `name`.

@@ -854,6 +854,11 @@ impl FairMethod for Salvi {
         false
     }
 
+    fn check_params(&self, options: &FairOptions) -> Result<()> {
+        local::check_fit_params(options)?;
+        salvi_params(options, None, false).map(|_| ())
+    }
+
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
         let fitted = local::fit_input(input, options)?;
         run_fitted(fitted, input, options)
@@ -879,7 +884,7 @@ fn run_fitted(
     input: &PointSeq,
     options: &FairOptions,
 ) -> Result<Outcome> {
-    let params = salvi_params(options, &fitted)?;
+    let params = salvi_params(options, Some(fitted.delta), fitted.free_ends)?;
     let (faired, report) = fair_curve(&fitted.curve, &params)?;
     let points = local::output_points(&faired, &fitted, input, options.fix_ends);
     let mut parameters = fitted.parameters.clone();
@@ -927,7 +932,13 @@ pub(crate) fn insert_common(parameters: &mut Map<String, Value>, r: &LocalReport
     );
 }
 
-fn salvi_params(options: &FairOptions, fitted: &local::FittedInput) -> Result<SalviParams> {
+/// The parameters of a run; `tolerance` (δ) and `free_ends` come from the fitted input. The
+/// smoother parameters are all checked, whichever smoother is chosen.
+fn salvi_params(
+    options: &FairOptions,
+    tolerance: Option<f64>,
+    free_ends: bool,
+) -> Result<SalviParams> {
     let samples = match options.params.get("samples").map(|s| s.trim()) {
         None | Some("auto") => None,
         Some(_) => {
@@ -940,26 +951,24 @@ fn salvi_params(options: &FairOptions, fitted: &local::FittedInput) -> Result<Sa
             Some(_) => options.param_usize_in(key, lo, lo, usize::MAX).map(Some),
         }
     };
+    let coefficients = auto_usize("target_coefficients", MIN_TARGET_COEFFICIENTS)?;
+    let half_width = auto_usize("half_width", 0)?;
+    let passes = options.param_usize_in("passes", DEFAULT_PASSES, 0, 1000)?;
     let smoother = match options.param_choice("smoother", "average", &["average", "bspline"])? {
-        "bspline" => Smoother::BSplineFit {
-            coefficients: auto_usize("target_coefficients", MIN_TARGET_COEFFICIENTS)?,
-        },
-        _ => Smoother::MovingAverage {
-            half_width: auto_usize("half_width", 0)?,
-            passes: options.param_usize_in("passes", DEFAULT_PASSES, 0, 1000)?,
-        },
+        "bspline" => Smoother::BSplineFit { coefficients },
+        _ => Smoother::MovingAverage { half_width, passes },
     };
     let max_iterations = options.iterations_or(DEFAULT_MAX_ITERATIONS);
     Ok(SalviParams {
         samples,
         smoother,
         pin_ends: local::param_bool(options, "pin_ends", false)?,
-        tolerance: Some(fitted.delta),
+        tolerance,
         tabu_length: options.param_usize_in("tabu", DEFAULT_TABU_LENGTH, 0, 1000)?,
         max_iterations,
         window: options.param_usize_in("window", DEFAULT_WINDOW, 0, usize::MAX)?,
         min_rel_improvement: WINDOW_MIN_REL_IMPROVEMENT,
-        free_ends: fitted.free_ends,
+        free_ends,
         skip_stalled: true,
     })
 }

@@ -324,6 +324,10 @@ impl FairMethod for SapidisFarin {
         false
     }
 
+    fn check_params(&self, options: &FairOptions) -> Result<()> {
+        Threshold::from_options(options).map(|_| ())
+    }
+
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
         if input.is_closed() {
             return Err(Error::ClosedUnsupported {

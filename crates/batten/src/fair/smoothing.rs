@@ -353,6 +353,14 @@ fn alpha_of(p: f64) -> f64 {
     }
 }
 
+/// The `p` parameter: `None` for `auto` (or not given), else a number in [0, 1].
+fn param_p(options: &FairOptions) -> Result<Option<f64>> {
+    match options.params.get("p").map(|s| s.trim()) {
+        None | Some("auto") => Ok(None),
+        Some(_) => options.param_f64_in("p", 1.0, 0.0, 1.0).map(Some),
+    }
+}
+
 fn check_p(p: f64, closed: bool) -> Result<()> {
     if !(0.0..=1.0).contains(&p) {
         return Err(Error::InvalidParameter {
@@ -1018,19 +1026,19 @@ impl FairMethod for Mst {
         true
     }
 
+    fn check_params(&self, options: &FairOptions) -> Result<()> {
+        param_p(options).map(|_| ())
+    }
+
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
         let points = input.points();
         let closed = input.is_closed();
         let n = points.len();
         let t = parameters(points, Parametrization::ChordLength, closed)?;
-        let p = match options.params.get("p").map(|s| s.trim()) {
-            None | Some("auto") => None,
-            Some(_) => {
-                let p = options.param_f64_in("p", 1.0, 0.0, 1.0)?;
-                check_p(p, closed)?;
-                Some(p)
-            }
-        };
+        let p = param_p(options)?;
+        if let Some(p) = p {
+            check_p(p, closed)?;
+        }
         let mut notes = Vec::new();
         let weights: Option<Vec<f64>> = if options.fix_ends && !closed {
             let mut w = vec![1.0; n];
