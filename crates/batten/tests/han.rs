@@ -351,6 +351,7 @@ fn run_case_vector(id: &str, procedure: Procedure) {
         Procedure::CoarseCase3 => seg.coarse_case3(),
         Procedure::FineCase1 => seg.fine_case1(),
         Procedure::FineCase2 => seg.fine_case2(),
+        Procedure::FineCase3 => seg.fine_case3(),
     };
     let ex = &v["expected"];
     check_moves(id, &moves, &ex["moves_in_order"], t);
@@ -417,6 +418,96 @@ fn vector_case_fine_case2() {
 #[test]
 fn vector_case_fine_case2_end() {
     run_case_vector("han.case.fine_case2.F2end", Procedure::FineCase2);
+}
+
+/// Second differences with a three-point run of the other sign: y'' > 0 everywhere except
+/// points `run..run+3`, which bend the other way.
+fn three_point_run(n: usize, run: usize) -> (Vec<f64>, Vec<f64>) {
+    let x: Vec<f64> = (0..n).map(|i| i as f64 * 0.5).collect();
+    let mut y = vec![0.0; n];
+    let mut slope = -1.0;
+    for i in 1..n {
+        let d = if (run..run + 3).contains(&i) {
+            -0.05
+        } else {
+            0.1
+        };
+        slope += d;
+        y[i] = y[i - 1] + slope * 0.5;
+    }
+    (x, y)
+}
+
+/// The maximal runs of one strict sign of `c` (`sgn0`), as (first index, length, sign).
+fn sign_runs(c: &[f64]) -> Vec<(usize, usize, i8)> {
+    let scale = c.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let mut runs: Vec<(usize, usize, i8)> = Vec::new();
+    for (i, v) in c.iter().enumerate() {
+        let s = batten::analysis::sgn0(*v, scale);
+        match runs.last_mut() {
+            Some(r) if r.2 == s => r.1 += 1,
+            _ => runs.push((i, 1, s)),
+        }
+    }
+    runs
+}
+
+#[test]
+fn fine_case3_removes_a_three_point_run_that_the_paper_cases_leave() {
+    let (x, y) = three_point_run(24, 10);
+    let seg = Segment::new(x, y).unwrap();
+    let runs = sign_runs(seg.c());
+    assert!(
+        runs.iter().any(|r| r.1 == 3 && r.2 < 0),
+        "no three-point run to remove: {runs:?}"
+    );
+    // The paper's fine cases do not touch it.
+    let mut paper = seg.clone();
+    assert!(paper.fine_case1().is_empty());
+    assert!(paper.fine_case2().is_empty());
+    assert_eq!(paper.inflection_count(), 2);
+    // Fine case 3 moves y_{i−1}..y_{i+3} and removes both inflections.
+    let mut ext = seg.clone();
+    let moves = ext.fine_case3();
+    assert!(!moves.is_empty());
+    for m in &moves {
+        assert_eq!(m.tag, MoveTag::F3);
+        assert_eq!(m.tag.as_str(), "F3");
+        assert_eq!(m.gammas().len(), 5);
+        let g = m.gammas();
+        let lf = ext.params().lambda_fine;
+        assert!((g[0] + lf * g[1]).abs() <= 1e-12 * g[1].abs());
+        assert!((g[4] + lf * g[3]).abs() <= 1e-12 * g[3].abs());
+    }
+    // The run is set to c = 0 (α = 0; its neighbours changed sign, so no α step). Moving the
+    // outer points leaves single opposite signs beside it, which fine case 1 removes in the
+    // next iteration.
+    let first = moves[0].i;
+    let scale = ext.c().iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    for k in first..first + 3 {
+        assert!(ext.c()[k].abs() <= 1e-12 * scale, "c[{k}] = {}", ext.c()[k]);
+    }
+    assert!(!seg.params().fine_run3, "off in a Segment unless asked for");
+    // Whole runs of the method on noisy sines as in `bench/compare_peers.py` (65 points,
+    // σ = 3 % of a tenth of the diagonal, tolerance 3σ): with fine case 3 (the default) fewer
+    // inflections are left than with the paper's cases alone.
+    let sigma = 0.038;
+    let on_opts = FairOptions::default().with_tolerance(3.0 * sigma);
+    let paper = on_opts.clone().with_param("fine_run3", "false");
+    let (mut with, mut without) = (0, 0);
+    for seed in 1..=20 {
+        let input = PointSeq::open(noisy_sine_curve(65, sigma, seed)).unwrap();
+        let on = fair::fair("han", &input, &on_opts).unwrap();
+        let off = fair::fair("han", &input, &paper).unwrap();
+        assert_eq!(on.report.parameters["fine_run3"], true);
+        assert_eq!(off.report.parameters["fine_run3"], false);
+        with += on.report.after.inflections;
+        without += off.report.after.inflections;
+    }
+    assert!(
+        with < without,
+        "{with} inflections with fine case 3, {without} without"
+    );
 }
 
 #[test]

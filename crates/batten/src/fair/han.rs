@@ -29,7 +29,15 @@
 //!   §1.7.2, reflection invariant);
 //! - fine case 2 unknowns `γ_{i−1} = −λ_f σ, γ_i = σ, γ_{i+1} = τ, γ_{i+2} = −λ_f τ`: the printed
 //!   unknowns give a singular system for mirror-symmetric spacing (\[FIX/CHOICE\] §1.7.2);
-//! - one iteration runs C1, C2 (+ends), C3 (+ends), F1, F2 (+ends) (\[CHOICE\] §1.7.3);
+//! - one iteration runs C1, C2 (+ends), C3 (+ends), F1, F2 (+ends) (\[CHOICE\] §1.7.3), and in
+//!   the `han` method then F3 (below);
+//! - **fine case 3, an extension not in the paper** ([`Segment::fine_case3`],
+//!   [`SegmentParams::fine_run3`], [`DEFAULT_FINE_RUN3`]): a run of three points of one sign of
+//!   c between opposite neighbours is set to 0 (then α) by moving five points, built like fine
+//!   case 2. The paper's fine cases remove runs of one and two points only; runs of three near
+//!   a true inflection were what left `han` with more spurious inflections than csaps on the
+//!   noisy sine of the peer comparison. A [`Segment`] runs the paper's cases unless asked; the
+//!   `han` method runs F3 by default, and `--set fine_run3=false` gives the paper's method;
 //! - unwrapped turning angles, first s with range > `max_turn`, segment `P_b..P_{s−1}`, minimum
 //!   segment length k + 2, k shared points, bisector frame from argmax/argmin (\[FIX\]/\[CHOICE\]
 //!   §1.8); segments of one pass are faired independently from the same points and blended
@@ -71,7 +79,8 @@
 //! - **`max_turn`** defaults to π/2, the value the spec recommends, not the paper's π
 //!   (\[CHOICE\], [`DEFAULT_MAX_TURN`]; `--set max_turn=pi` restores the paper's). With π a
 //!   densely sampled segment's end chords are nearly vertical in its frame, and on the peer
-//!   comparison π leaves more spurious inflections than csaps while π/2 leaves fewer.
+//!   comparison π leaves more spurious inflections than csaps in 6 of 10 cases, π/2 in 1 of 15
+//!   (and none with fine case 3 too).
 //! - A segment that is not a function in its bisector frame, or has a chord steeper than
 //!   [`MAX_LOCAL_SLOPE`] there (\[CHOICE\] guard), is re-partitioned with half the turning
 //!   threshold, down to [`MIN_FALLBACK_TURN`] = π/8, and otherwise left as it is; both are
@@ -97,6 +106,10 @@ pub const DEFAULT_LAMBDA_COARSE: f64 = 0.8;
 pub const DEFAULT_LAMBDA_FINE: f64 = 0.75;
 /// Default factor of the fine-phase α rule, `α = factor · v` \[PAPER: 1/5\].
 pub const DEFAULT_ALPHA_FACTOR: f64 = 0.2;
+/// Whether the `han` method runs fine case 3 ([`SegmentParams::fine_run3`]), an extension
+/// not in the paper \[CHOICE\]: on the peer comparison it is what makes `han` leave no more
+/// spurious inflections than csaps in every case (`fine_run3=false` gives the paper's method).
+pub const DEFAULT_FINE_RUN3: bool = true;
 /// Default number of points shared by consecutive segments, k \[PAPER\].
 pub const DEFAULT_OVERLAP: usize = 5;
 /// Default number of pipeline passes (partition, fair, blend) \[CHOICE\].
@@ -107,7 +120,7 @@ pub const PAPER_MAX_TURN: f64 = PI;
 /// (§1.8 note). Segments then stay far from vertical local slopes, where the function-spline
 /// proxy breaks down; with the paper's π the end chords of a densely sampled segment are
 /// nearly vertical in its frame. Measured on the peer comparison (`bench/compare_peers.py`),
-/// π/2 is what makes `han` leave fewer spurious inflections than csaps.
+/// π/2 (with fine case 3) is what makes `han` leave no more spurious inflections than csaps.
 pub const DEFAULT_MAX_TURN: f64 = FRAC_PI_2;
 /// The recommended turning threshold: the default, π/2.
 pub const RECOMMENDED_MAX_TURN: f64 = DEFAULT_MAX_TURN;
@@ -563,6 +576,12 @@ pub struct SegmentParams {
     ///
     /// Default value: [`DEFAULT_ALPHA_FACTOR`] (0.2).
     pub alpha_factor: f64,
+    /// Also run fine case 3 ([`Segment::fine_case3`]) after fine case 2 in every iteration:
+    /// an extension, not in the paper, for runs of three points of one sign of c, which
+    /// neither fine case removes.
+    ///
+    /// Default value: false here (the paper's method); the `han` method turns it on.
+    pub fine_run3: bool,
 }
 
 impl SegmentParams {
@@ -571,6 +590,7 @@ impl SegmentParams {
         lambda_coarse: DEFAULT_LAMBDA_COARSE,
         lambda_fine: DEFAULT_LAMBDA_FINE,
         alpha_factor: DEFAULT_ALPHA_FACTOR,
+        fine_run3: false,
     };
 
     /// Set `λ_c`.
@@ -588,6 +608,12 @@ impl SegmentParams {
     /// Set the α factor.
     pub fn with_alpha_factor(mut self, v: f64) -> SegmentParams {
         self.alpha_factor = v;
+        self
+    }
+
+    /// Run fine case 3 too (see [`SegmentParams::fine_run3`]).
+    pub fn with_fine_run3(mut self, on: bool) -> SegmentParams {
+        self.fine_run3 = on;
         self
     }
 
@@ -633,6 +659,8 @@ pub enum MoveTag {
     F2,
     /// Fine case 2 end rule: `c_1 = c_2` (or `c_{n−1} = c_n`) set to 0.
     F2End,
+    /// Fine case 3 (an extension, not in the paper): a three-point run of one sign of c.
+    F3,
 }
 
 impl MoveTag {
@@ -648,12 +676,16 @@ impl MoveTag {
             MoveTag::F1 => "F1",
             MoveTag::F2 => "F2",
             MoveTag::F2End => "F2end",
+            MoveTag::F3 => "F3",
         }
     }
 
     /// True for the fine-phase tags (they target `c`), false for the coarse ones (`e`).
     pub fn is_fine(self) -> bool {
-        matches!(self, MoveTag::F1 | MoveTag::F2 | MoveTag::F2End)
+        matches!(
+            self,
+            MoveTag::F1 | MoveTag::F2 | MoveTag::F2End | MoveTag::F3
+        )
     }
 }
 
@@ -667,7 +699,7 @@ pub struct CaseMove {
     /// The first displaced point (0-based).
     pub start: usize,
     len: usize,
-    gammas: [f64; 4],
+    gammas: [f64; 5],
     /// The targeted indicator at `i` before the move: `e_i` for coarse rules, `c_i` for fine.
     pub before: f64,
     /// The same value after the move.
@@ -714,6 +746,9 @@ pub enum Procedure {
     FineCase1,
     /// Fine case 2 with its end rules ([`Segment::fine_case2`]).
     FineCase2,
+    /// Fine case 3 ([`Segment::fine_case3`]), an extension run after fine case 2 when
+    /// [`SegmentParams::fine_run3`] is set.
+    FineCase3,
 }
 
 impl Procedure {
@@ -901,6 +936,12 @@ impl Segment {
                     on_move(m);
                 });
             }
+            if self.params.fine_run3 {
+                self.run_procedure(Procedure::FineCase3, &mut |m: &CaseMove| {
+                    moved = true;
+                    on_move(m);
+                });
+            }
             if !moved {
                 break;
             }
@@ -917,6 +958,7 @@ impl Segment {
             Procedure::CoarseCase3 => self.coarse_case3_with(on_move),
             Procedure::FineCase1 => self.fine_case1_with(on_move),
             Procedure::FineCase2 => self.fine_case2_with(on_move),
+            Procedure::FineCase3 => self.fine_case3_with(on_move),
         }
     }
 
@@ -978,6 +1020,14 @@ impl Segment {
     /// `c_{i+2}`, `c_{i+3}` is set to 0 (then α); then the end rules.
     pub fn fine_case2(&mut self) -> Vec<CaseMove> {
         self.collect(Procedure::FineCase2)
+    }
+
+    /// Fine case 3, an extension not in the paper ([`SegmentParams::fine_run3`]): a run
+    /// `c_i, c_{i+1}, c_{i+2}` of one sign between `c_{i−1}` and `c_{i+3}, c_{i+4}` of the other
+    /// is set to 0 (then α) by moving `y_{i−1}..y_{i+3}`, the outer two by `−λ_f` times their
+    /// neighbours, as fine case 2 does for a pair.
+    pub fn fine_case3(&mut self) -> Vec<CaseMove> {
+        self.collect(Procedure::FineCase3)
     }
 
     fn collect(&mut self, p: Procedure) -> Vec<CaseMove> {
@@ -1196,6 +1246,57 @@ impl Segment {
         }
     }
 
+    /// Fine case 3 (extension): unknowns `γ_{i−1} = −λ_f σ, γ_i = σ, γ_{i+1} = τ, γ_{i+2} = ρ,
+    /// γ_{i+3} = −λ_f ρ`, solved for `c_i = c_{i+1} = c_{i+2} = α`; α = 0 first, then the α
+    /// rule from `c_{i−1}, c_{i+3}` if both kept their signs, as in fine case 2.
+    fn fine_case3_with(&mut self, on_move: &mut impl FnMut(&CaseMove)) {
+        let n = self.len();
+        let lf = self.params.lambda_fine;
+        if n < 8 {
+            return;
+        }
+        for i in 2..=n - 6 {
+            let fires = self.c_same(i, i + 1)
+                && self.c_same(i, i + 2)
+                && self.c_opp(i, i - 1)
+                && self.c_opp(i, i + 3)
+                && self.c_opp(i, i + 4);
+            if !fires {
+                continue;
+            }
+            let (sl, sr) = (self.c_sign(i - 1), self.c_sign(i + 3));
+            for pass in 0..2 {
+                let alpha = if pass == 0 {
+                    0.0
+                } else {
+                    self.alpha(i - 1, i + 3)
+                };
+                let r = &self.resp;
+                let m = nalgebra::Matrix3::from_fn(|row, col| {
+                    let k = i + row;
+                    match col {
+                        0 => r.c_at(k, i) - lf * r.c_at(k, i - 1),
+                        1 => r.c_at(k, i + 1),
+                        _ => r.c_at(k, i + 2) - lf * r.c_at(k, i + 3),
+                    }
+                });
+                let rhs = nalgebra::Vector3::new(
+                    alpha - self.c[i],
+                    alpha - self.c[i + 1],
+                    alpha - self.c[i + 2],
+                );
+                let Some(sol) = m.lu().solve(&rhs) else {
+                    break;
+                };
+                let (s, t, q) = (sol[0], sol[1], sol[2]);
+                self.apply(MoveTag::F3, i, i - 1, &[-lf * s, s, t, q, -lf * q], on_move);
+                if !(self.c_sign(i - 1) == sl && self.c_sign(i + 3) == sr) {
+                    break;
+                }
+            }
+        }
+    }
+
     // --- applying a move ---------------------------------------------------------------------
 
     /// Move points `start..start+gammas.len()` by `gammas` (scaled back to the bounds), update
@@ -1228,7 +1329,7 @@ impl Segment {
     /// Move points `start..start+gammas.len()` (interior, at most 4) by `gammas`, scaled back
     /// to the bounds, and update c (eq 13), e and their maxima on the changed range. Returns
     /// the scale and the applied displacements, or `None` when nothing moved.
-    fn move_points(&mut self, start: usize, gammas: &[f64]) -> Option<(f64, [f64; 4])> {
+    fn move_points(&mut self, start: usize, gammas: &[f64]) -> Option<(f64, [f64; 5])> {
         let len = gammas.len();
         if gammas.iter().any(|g| !g.is_finite()) || gammas.iter().all(|g| *g == 0.0) {
             return None;
@@ -1251,8 +1352,8 @@ impl Segment {
                 return None;
             }
         }
-        let mut targets = [0.0; 4];
-        let mut applied = [0.0; 4];
+        let mut targets = [0.0; 5];
+        let mut applied = [0.0; 5];
         for (k, &g) in gammas.iter().enumerate() {
             let p = start + k;
             let mut target = self.y[p] + scale * g;
@@ -1508,6 +1609,12 @@ static PARAMS: &[ParamSpec] = &[
               vertical slopes",
     },
     ParamSpec {
+        name: "fine_run3",
+        default: "true",
+        doc: "extension, not in the paper: also remove runs of three points of one sign of c \
+              (fine case 3); false gives the paper's method",
+    },
+    ParamSpec {
         name: "alpha_factor",
         default: "0.2",
         doc: "fine phase target α = factor × the smaller-magnitude neighbour of c, in [0, 1]",
@@ -1530,6 +1637,8 @@ impl HanParams {
             .with_lambda_coarse(o.param_f64_in("lambda_coarse", DEFAULT_LAMBDA_COARSE, 0.0, 1.0)?)
             .with_lambda_fine(o.param_f64_in("lambda_fine", DEFAULT_LAMBDA_FINE, 0.0, 1.0)?)
             .with_alpha_factor(o.param_f64_in("alpha_factor", DEFAULT_ALPHA_FACTOR, 0.0, 1.0)?);
+        let segment =
+            segment.with_fine_run3(super::local::param_bool(o, "fine_run3", DEFAULT_FINE_RUN3)?);
         segment.validate()?;
         Ok(HanParams {
             segment,
@@ -1906,6 +2015,7 @@ impl FairMethod for Han {
         parameters.insert("lambda_coarse".into(), num(params.segment.lambda_coarse));
         parameters.insert("lambda_fine".into(), num(params.segment.lambda_fine));
         parameters.insert("alpha_factor".into(), num(params.segment.alpha_factor));
+        parameters.insert("fine_run3".into(), params.segment.fine_run3.into());
         parameters.insert("overlap".into(), params.overlap.into());
         parameters.insert("passes".into(), params.passes.into());
         parameters.insert("max_turn".into(), num(params.max_turn));
