@@ -168,7 +168,7 @@ fn mixed_directory_writes_good_files_and_reports_the_bad_one() {
     let json = read_json(&out.join("d.json"));
     assert_eq!(json["points"].as_array().unwrap().len(), 32);
     let report = read_json(&out.join("a.report.json"));
-    assert_eq!(report["method"], "mst");
+    assert_eq!(report["method"], "han");
     assert_eq!(report["tolerance_met"], true);
     assert_eq!(report["before"]["points"], 30);
 
@@ -408,6 +408,8 @@ fn failures_and_missed_tolerances_exit_1() {
         s(&inp),
         "-o",
         s(&out),
+        "--method",
+        "mst",
         "--set",
         "p=0.5",
         "--tolerance",
@@ -439,14 +441,14 @@ fn bad_options_exit_2_and_write_nothing() {
         (&["--method", "nope"], &["unknown method 'nope'", "mst"]),
         (
             &["--set", "bogus=1"],
-            &["unknown option 'bogus' for method mst"],
+            &["unknown option 'bogus' for method han"],
         ),
         (&["--set", "p"], &["malformed --set 'p'"]),
         (&["--tolerance=-1"], &["tolerance", "positive"]),
         (&["--tolerance", "nan"], &["tolerance", "positive"]),
         // Parameter values are checked up front too, before any file is read.
         (
-            &["--set", "p=2"],
+            &["--method", "mst", "--set", "p=2"],
             &["invalid value for p: 2 is outside [0, 1]"],
         ),
         (

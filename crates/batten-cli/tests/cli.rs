@@ -192,23 +192,39 @@ fn bad_options_exit_2_before_anything_runs() {
     };
     let cases: &[(&[&str], &[&str])] = &[
         (&["--method", "nope"], &["unknown method 'nope'", "mst"]),
+        // The default method, han.
         (
             &["--set", "bogus=1"],
-            &["unknown option 'bogus' for method mst", "known: p"],
+            &[
+                "unknown option 'bogus' for method han",
+                "known: lambda_coarse",
+            ],
         ),
         (
-            &["--set", "p"],
-            &["malformed --set 'p': expected KEY=VALUE"],
+            &["--set", "lambda_fine"],
+            &["malformed --set 'lambda_fine': expected KEY=VALUE"],
         ),
         (&["--set", "=1"], &["malformed --set '=1'"]),
         (
-            &["--set", "p=0.5", "--set", "p=0.6"],
-            &["--set p is given more than once"],
+            &["--set", "lambda_fine=0.5", "--set", "lambda_fine=0.6"],
+            &["--set lambda_fine is given more than once"],
         ),
         (&["--tolerance=-1"], &["tolerance", "positive"]),
         (&["--tolerance", "nan"], &["tolerance", "positive"]),
-        (&["--set", "p=abc"], &["'abc' is not a finite number"]),
-        (&["--set", "p=2"], &["2 is outside [0, 1]"]),
+        (
+            &["--set", "lambda_fine=abc"],
+            &["'abc' is not a finite number"],
+        ),
+        (&["--set", "lambda_fine=2"], &["2 is outside [0, 1]"]),
+        // Another method's parameters.
+        (
+            &["--method", "mst", "--set", "bogus=1"],
+            &["unknown option 'bogus' for method mst", "known: p"],
+        ),
+        (
+            &["--method", "mst", "--set", "p=2"],
+            &["2 is outside [0, 1]"],
+        ),
     ];
     for (extra, want) in cases {
         let o = fair(extra);
@@ -326,7 +342,7 @@ fn fair_round_trip_writes_points_and_report() {
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let err = stderr(&o);
     assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(err.starts_with("mst: "), "{err}");
+    assert!(err.starts_with("han: "), "{err}");
     assert!(err.contains("max displacement"), "{err}");
     assert!(o.stdout.is_empty());
     assert_eq!(read_csv_points(&out).len(), 30);
@@ -344,7 +360,7 @@ fn fair_round_trip_writes_points_and_report() {
     ] {
         assert!(r.get(key).is_some(), "report lacks {key}: {r}");
     }
-    assert_eq!(r["method"], "mst");
+    assert_eq!(r["method"], "han");
     assert_eq!(r["tolerance_met"], true);
     assert_eq!(r["before"]["points"], 30);
     assert_eq!(r["after"]["points"], 30);
@@ -420,6 +436,8 @@ fn tolerance_not_met_exits_1_but_writes_output() {
         s(&input),
         "-o",
         s(&out),
+        "--method",
+        "mst",
         "--set",
         "p=0.5",
         "--tolerance",
