@@ -764,12 +764,24 @@ fn segment_is_reflection_invariant() {
     let v = vector("han.fair_segment.noisy_sine");
     let x = arr(&v["inputs"]["x"]);
     let y = arr(&v["inputs"]["y"]);
-    let mut a = Segment::new(x.clone(), y.clone()).unwrap();
-    let mut b = Segment::new(x, y.iter().map(|v| -v).collect()).unwrap();
-    a.fair(10, |_| {});
-    b.fair(10, |_| {});
-    for (p, q) in a.y().iter().zip(b.y()) {
-        assert!((p + q).abs() < 1e-12);
+    // With and without fine case 3 (its α rule is the same).
+    for run3 in [false, true] {
+        let params = SegmentParams::DEFAULT.with_fine_run3(run3);
+        let seg = |y: Vec<f64>| {
+            Segment::new(x.clone(), y)
+                .unwrap()
+                .with_params(params)
+                .unwrap()
+        };
+        let mut a = seg(y.clone());
+        let mut b = seg(y.iter().map(|v| -v).collect());
+        let mut f3 = 0;
+        a.fair(10, |m| f3 += usize::from(m.tag == MoveTag::F3));
+        b.fair(10, |_| {});
+        assert_eq!(f3 > 0, run3, "fine case 3 moves: {f3}");
+        for (p, q) in a.y().iter().zip(b.y()) {
+            assert!((p + q).abs() < 1e-12, "fine_run3 = {run3}");
+        }
     }
 }
 
@@ -782,6 +794,8 @@ fn segment_bounds_are_never_left() {
     let lo: Vec<f64> = y.iter().map(|v| v - d).collect();
     let hi: Vec<f64> = y.iter().map(|v| v + d).collect();
     let mut seg = Segment::new(x, y.clone())
+        .unwrap()
+        .with_params(SegmentParams::DEFAULT.with_fine_run3(true))
         .unwrap()
         .with_bounds(lo, hi)
         .unwrap();
