@@ -1344,7 +1344,8 @@ fn same_run(mut a: Segment, mut b: Segment, iterations: usize, scale: f64) -> Re
                 .all(|(p, q)| (p - q).abs() <= 1e-9 * scale)
     };
     for it in 0..iterations {
-        for p in Procedure::ITERATION {
+        let extra = a.params().fine_run3.then_some(Procedure::FineCase3);
+        for p in Procedure::ITERATION.into_iter().chain(extra) {
             let (mut a0, mut b0) = (a.clone(), b.clone());
             let (mut ma, mut mb) = (Vec::new(), Vec::new());
             a.run_procedure(p, &mut |m: &CaseMove| ma.push(*m));
@@ -1453,7 +1454,10 @@ proptest! {
                 all_same = false;
                 continue;
             }
-            if let (Ok(a), Ok(b)) = (Segment::new(xa, ya), Segment::new(xb, yb)) {
+            // The method's segment parameters (fine case 3 on).
+            let method = SegmentParams::DEFAULT.with_fine_run3(han::DEFAULT_FINE_RUN3);
+            let seg = |x, y| Segment::new(x, y).and_then(|s| s.with_params(method));
+            if let (Ok(a), Ok(b)) = (seg(xa, ya), seg(xb, yb)) {
                 match same_run(a, b, han::DEFAULT_ITERATIONS, scale) {
                     Ok(same) => all_same &= same,
                     Err(e) => prop_assert!(false, "{}", e),
