@@ -61,8 +61,8 @@
 //! The segments of a pass are faired in parallel (rayon); blending and the report follow the
 //! curve's order, so the result does not depend on the number of threads.
 //! Measured (release, `benches/han.rs`, the spiral with a 1 % wobble): see `BENCHMARKS.md`;
-//! about 0.2 s for 10⁵ points and 2 s for 10⁶ on 2 cores (3.5 s on one) with the default
-//! 3 passes × 10 iterations, some 17 million moves at 10⁶.
+//! about 0.25 s for 10⁵ points and 2.5 s for 10⁶ on 2 cores with the default 3 passes × 10
+//! iterations (2 s without fine case 3), some 17 million moves at 10⁶.
 //!
 //! # Common options
 //!
@@ -1256,10 +1256,11 @@ impl Segment {
             return;
         }
         for i in 2..=n - 6 {
-            let fires = self.c_same(i, i + 1)
-                && self.c_same(i, i + 2)
-                && self.c_opp(i, i - 1)
+            // The most selective tests first (on smooth stretches neighbours share a sign).
+            let fires = self.c_opp(i, i - 1)
                 && self.c_opp(i, i + 3)
+                && self.c_same(i, i + 1)
+                && self.c_same(i, i + 2)
                 && self.c_opp(i, i + 4);
             if !fires {
                 continue;
