@@ -1741,7 +1741,7 @@ fn open_pass(
     // The segments of a pass are faired independently from the same points, so in parallel;
     // blending and the logs then follow the curve's order, so the result does not depend on
     // the number of threads.
-    let faired: Vec<Result<(Vec<Point>, usize, RunLog)>> = spans
+    let results: Vec<Result<(Vec<Point>, usize, RunLog)>> = spans
         .par_iter()
         .map(|span| {
             let range = span.start..span.end + 1;
@@ -1762,7 +1762,7 @@ fn open_pass(
     let mut out = cur.to_vec();
     let mut moves = 0;
     let mut covered_to: Option<usize> = None;
-    for (span, result) in spans.iter().zip(faired) {
+    for (span, result) in spans.iter().zip(results) {
         let (faired, m, sub_log) = result?;
         log.append(sub_log);
         moves += m;

@@ -1027,14 +1027,13 @@ pub(super) fn driven_parameters(
     p
 }
 
-/// The parameters of the point-only KP methods, checked without an input: the threshold and,
-/// on the chord-length spline, `reparametrize`.
-fn check_point_params(uniform: bool, options: &FairOptions) -> Result<()> {
-    Threshold::from_options(options)?;
-    if !uniform {
-        options.param_choice("reparametrize", "true", &["true", "false"])?;
-    }
-    Ok(())
+/// The parameters of the point-only KP methods: the threshold and, on the chord-length spline,
+/// `reparametrize` (always false on the uniform one). They need no input.
+fn point_params(uniform: bool, options: &FairOptions) -> Result<(Threshold, bool)> {
+    let threshold = Threshold::from_options(options)?;
+    let reparametrize =
+        !uniform && options.param_choice("reparametrize", "true", &["true", "false"])? == "true";
+    Ok((threshold, reparametrize))
 }
 
 /// The rule of the `energy` method, from its `mode` parameter.
@@ -1058,12 +1057,7 @@ fn run_points(
     input: &PointSeq,
     options: &FairOptions,
 ) -> Result<Outcome> {
-    let threshold = Threshold::from_options(options)?;
-    let reparametrize = if uniform {
-        false
-    } else {
-        options.param_choice("reparametrize", "true", &["true", "false"])? == "true"
-    };
+    let (threshold, reparametrize) = point_params(uniform, options)?;
     let closed = input.is_closed();
     let mut state = SplineState::new(input.points(), closed, !uniform, reparametrize, rule)?;
     let candidates = if closed { input.len() } else { input.len() - 2 };
@@ -1294,7 +1288,7 @@ impl FairMethod for Kjellander {
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {
-        check_point_params(true, options)
+        point_params(true, options).map(|_| ())
     }
 
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
@@ -1320,7 +1314,7 @@ impl FairMethod for Poliakoff {
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {
-        check_point_params(false, options)
+        point_params(false, options).map(|_| ())
     }
 
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
@@ -1352,7 +1346,7 @@ impl FairMethod for Energy {
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {
         energy_rule(options)?;
-        check_point_params(false, options)
+        point_params(false, options).map(|_| ())
     }
 
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {

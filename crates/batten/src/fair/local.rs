@@ -430,7 +430,7 @@ pub(crate) const FIT_PARAMS: [ParamSpec; 3] = [
 /// # Errors
 /// [`Error::InvalidParameter`].
 pub(crate) fn check_fit_params(options: &FairOptions) -> Result<()> {
-    let degree = options.param_usize_in("degree", DEFAULT_FIT_DEGREE, 2, 5)?;
+    let degree = fit_degree(options)?;
     if !matches!(
         options.params.get("control_points").map(|s| s.trim()),
         None | Some("auto")
@@ -438,6 +438,11 @@ pub(crate) fn check_fit_params(options: &FairOptions) -> Result<()> {
         options.param_usize_in("control_points", degree + 1, degree + 1, usize::MAX)?;
     }
     param_bool(options, "free_ends", false).map(|_| ())
+}
+
+/// The `degree` of the B-spline fitted to point input, 2..=5.
+fn fit_degree(options: &FairOptions) -> Result<usize> {
+    options.param_usize_in("degree", DEFAULT_FIT_DEGREE, 2, 5)
 }
 
 /// A boolean method parameter: `true/false`, `yes/no`, `1/0`, `on/off`.
@@ -493,7 +498,7 @@ pub(crate) struct FittedInput {
 /// [`BSplineCurve::approximate`].
 pub(crate) fn fit_input(input: &PointSeq, options: &FairOptions) -> Result<FittedInput> {
     let points = input.points();
-    let degree = options.param_usize_in("degree", DEFAULT_FIT_DEGREE, 2, 5)?;
+    let degree = fit_degree(options)?;
     let mut notes = Vec::new();
     let mut parameters = serde_json::Map::new();
     let (curve, params, fit) = match options.params.get("control_points").map(|s| s.trim()) {
