@@ -18,7 +18,18 @@ Speed: wall time of each tool on the same data at several sizes.
 Not part of CI. Usage:
     cargo build --release -p batten-cli
     python3 bench/compare_peers.py [--quick] [--out bench/results.md]
+        [--methods han,mst] [--peers csaps,...|none] [--n 65]
 Needs: numpy, scipy, csaps; optional cadquery-ocp-novtk.
+
+Options:
+  --methods  comma-separated method specs. A spec is a method name, optionally with options in
+             brackets separated by ';': `han[passes=2;max_iterations=5]`. `max_iterations=N`
+             becomes `--max-iterations N`, every other `key=value` becomes `--set key=value` on
+             the `batten fair` command line. The whole spec string is the `matched to`/tool label.
+  --peers    comma-separated peers to run (csaps, scipy-smoothing, scipy-splprep, occt), or
+             `none`; default: every available peer.
+  --n        number of points per curve (default 65).
+Environment: BATTEN_BIN overrides the batten binary (default target/release/batten).
 """
 import argparse
 import json
@@ -48,7 +59,7 @@ except ImportError:  # pragma: no cover
     HAVE_OCCT = False
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BATTEN = os.path.join(ROOT, "target", "release", "batten")
+BATTEN = os.environ.get("BATTEN_BIN") or os.path.join(ROOT, "target", "release", "batten")
 
 
 # ---------------------------------------------------------------- truth curves
@@ -182,11 +193,29 @@ if HAVE_OCCT:
     PEERS["occt"] = peer_occt
 
 
+def method_args(spec):
+    """`han[passes=2;max_iterations=5]` -> ["--method", "han", "--set", "passes=2", "--max-iterations", "5"]."""
+    name, _, opts = spec.partition("[")
+    if opts and not opts.endswith("]"):
+        raise SystemExit(f"bad method spec {spec!r}: expected name[key=value;...]")
+    args = ["--method", name.strip()]
+    for opt in filter(None, (o.strip() for o in opts[:-1].split(";"))):
+        key, eq, value = opt.partition("=")
+        if not eq:
+            raise SystemExit(f"bad option {opt!r} in method spec {spec!r}: expected key=value")
+        key, value = key.strip(), value.strip()
+        if key.replace("-", "_") == "max_iterations":
+            args += ["--max-iterations", value]
+        else:
+            args += ["--set", f"{key}={value}"]
+    return args
+
+
 def run_batten(method, p, tol, tmp):
     inp, out, rep = (os.path.join(tmp, n) for n in ("in.csv", "out.csv", "rep.json"))
     write_csv(inp, p)
     t0 = time.perf_counter()
-    r = subprocess.run([BATTEN, "fair", inp, "-o", out, "--method", method, "--tolerance", repr(float(tol)),
+    r = subprocess.run([BATTEN, "fair", inp, "-o", out, *method_args(method), "--tolerance", repr(float(tol)),
                         "--report", rep], capture_output=True, text=True)
     dt = time.perf_counter() - t0
     if r.returncode not in (0, 1) or not os.path.exists(out):
@@ -200,10 +229,22 @@ def main():
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--methods", default="han,mst")
     ap.add_argument("--out", default=None)
+    ap.add_argument("--peers", default=None, help="comma-separated peers, or 'none' (default: all available)")
+    ap.add_argument("--n", type=int, default=65, help="points per curve")
     args = ap.parse_args()
+    peers = PEERS
+    if args.peers is not None:
+        names = [] if args.peers.strip() == "none" else [s.strip() for s in args.peers.split(",") if s.strip()]
+        unknown = [s for s in names if s not in PEERS]
+        if unknown:
+            raise SystemExit(f"unknown peer(s) {', '.join(unknown)}; available: {', '.join(PEERS)}")
+        peers = {s: PEERS[s] for s in names}
+    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+    for m in methods:
+        method_args(m)  # reject a malformed spec before the run
     seeds = [1, 2] if args.quick else [1, 2, 3, 4, 5]
     noises = [0.01, 0.03] if args.quick else [0.005, 0.01, 0.03]
-    n = 65
+    n = args.n
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for name, f in CURVES.items():
@@ -218,13 +259,13 @@ def main():
                     noisy[1:-1] += rng.normal(0, sigma * scale / 10, size=(n - 2, 2))
                     DATA = noisy
                     tol = 3 * sigma * scale / 10
-                    for method in args.methods.split(","):
+                    for method in methods:
                         res, dt = run_batten(method, noisy, tol, tmp)
                         if res is None:
                             continue
                         d = max_dev(res, noisy)
                         results = {f"batten-{method}": (res, dt)}
-                        for pname, peer in PEERS.items():
+                        for pname, peer in peers.items():
                             t0 = time.perf_counter()
                             try:
                                 pr = peer(noisy, d)
