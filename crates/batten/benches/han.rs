@@ -1,6 +1,6 @@
 //! The `han` method (Han et al., spec §1) for n = 10³ … 10⁶ points: the whole method with the
 //! default options (partition, 3 passes × 10 iterations per segment, blending) on the spiral of
-//! `benches/mst.rs`, and one sweep (one iteration of the five case procedures C1, C2, C3, F1,
+//! `benches/mst.rs`, the same on the spiral without its wobble at 10⁶ points, and one sweep (one iteration of the five case procedures C1, C2, C3, F1,
 //! F2) over a single function segment, so that the per-sweep cost is visible on its own.
 //!
 //! The 10⁶ whole-method case takes several seconds a run; Criterion may warn that it extended
@@ -31,15 +31,15 @@ fn noise_source() -> impl FnMut() -> f64 {
 }
 
 /// The benchmark curve (the same as `benches/mst.rs` and `bench/csaps_speed.py`): a spiral arc
-/// with a deterministic pseudo-random wobble of 1% of the point spacing.
-fn curve(n: usize) -> Vec<Point> {
+/// with a deterministic pseudo-random wobble of `wobble` times the point spacing (1 %).
+fn curve(n: usize, wobble: f64) -> Vec<Point> {
     let mut noise = noise_source();
     let step = 6.0 * std::f64::consts::PI / n as f64;
     (0..n)
         .map(|i| {
             let a = i as f64 * step;
             let r = 1.0 + 0.3 * a;
-            let e = 0.01 * step * r;
+            let e = wobble * step * r;
             Point::new(r * a.cos() + e * noise(), r * a.sin() + e * noise())
         })
         .collect()
@@ -63,13 +63,22 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("han");
     g.sample_size(10);
     for n in SIZES {
-        let seq = PointSeq::open(curve(n)).unwrap();
+        let seq = PointSeq::open(curve(n, 0.01)).unwrap();
         let opts = FairOptions::default();
         g.throughput(Throughput::Elements(n as u64));
         g.bench_with_input(BenchmarkId::new("method", n), &n, |b, _| {
             b.iter(|| Han.run(black_box(&seq), &opts).unwrap())
         });
     }
+    // The clean spiral (no wobble): only rounding noise, which han leaves alone, so this is
+    // the cost of the set-up and one sweep of scans per segment.
+    let n = 1_000_000;
+    let seq = PointSeq::open(curve(n, 0.0)).unwrap();
+    let opts = FairOptions::default();
+    g.throughput(Throughput::Elements(n as u64));
+    g.bench_with_input(BenchmarkId::new("clean", n), &n, |b, _| {
+        b.iter(|| Han.run(black_box(&seq), &opts).unwrap())
+    });
     g.finish();
 
     // One sweep (one iteration of the five case procedures) over one segment, from the same

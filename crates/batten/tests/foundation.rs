@@ -1261,9 +1261,7 @@ fn parametric_cubic_matches_scipy() {
 /// The size of rounding noise in the curvature of a spline through `pts`: `ε·R/h_min²` with R
 /// the largest coordinate magnitude and h_min the shortest chord.
 fn curvature_noise(pts: &[Point]) -> f64 {
-    let r = pts
-        .iter()
-        .fold(0.0_f64, |a, p| a.max(p.x.abs()).max(p.y.abs()));
+    let r = batten::geom::max_abs_coordinate(pts);
     let h = pts
         .windows(2)
         .fold(f64::INFINITY, |a, w| a.min((w[1] - w[0]).length()));

@@ -833,6 +833,95 @@ fn segment_errors() {
     assert!(seg.with_bounds(vec![0.1; 5], vec![1.0; 5]).is_err());
 }
 
+/// A dense sine segment `x = off + i·h`, `y = off + sin((x − off)/2)`: its c and e carry the
+/// rounding of coordinates of magnitude `off` and nothing else worth fairing.
+fn clean_dense_segment(n: usize, off: f64) -> Segment {
+    let h = 12.0 * PI / n as f64;
+    let x: Vec<f64> = (0..n).map(|i| off + i as f64 * h).collect();
+    let y: Vec<f64> = x.iter().map(|&v| off + ((v - off) / 2.0).sin()).collect();
+    Segment::new(x, y).unwrap()
+}
+
+#[test]
+fn rounding_noise_is_not_faired() {
+    // 20 000 samples at an offset of 1000: e is rounding noise (≈ 0.3 against a signal of
+    // ≈ 1e-6) and c is noise near the 5 true inflections. The floors count both as 0.
+    let mut seg = clean_dense_segment(20_000, 1000.0);
+    let noise = seg
+        .e()
+        .iter()
+        .zip(seg.e_floor())
+        .skip(50)
+        .take(19_900)
+        .map(|(e, f)| e.abs() / f)
+        .fold(0.0_f64, f64::max);
+    assert!(noise > 1e-4 && noise < 1.0, "largest |e| / floor = {noise}");
+    // Han's count takes strict sign changes only: an inflection whose nearest c is below the
+    // floor is not counted.
+    let inflections = seg.inflection_count();
+    assert!((4..=5).contains(&inflections), "{inflections}");
+    assert_eq!(seg.vibration_count(), 0);
+    let y0 = seg.y().to_vec();
+    let mut moves = 0;
+    assert_eq!(seg.fair(10, |_| moves += 1), 0);
+    assert_eq!(moves, 0);
+    assert_eq!(seg.y(), &y0[..]);
+
+    // The floors only filter rounding: noise of 1e-9 (10⁶ times the rounding of 1000) is
+    // faired as before.
+    let base = clean_dense_segment(20_000, 1000.0);
+    let mut state = 7_u64;
+    let y: Vec<f64> = base
+        .y()
+        .iter()
+        .map(|v| {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1);
+            v + 1e-9 * ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5)
+        })
+        .collect();
+    let mut noisy = Segment::new(base.x().to_vec(), y).unwrap();
+    let before = noisy.vibration_count();
+    assert!(before > 1000, "{before} vibrations");
+    assert!(noisy.fair(3, |_| {}) > 0);
+    assert!(noisy.vibration_count() < before);
+}
+
+#[test]
+fn coordinate_scale_raises_the_floors() {
+    let seg = clean_dense_segment(1000, 0.0);
+    let raised = seg.clone().with_coordinate_scale(1e7);
+    for (a, b) in seg.c_floor().iter().zip(raised.c_floor()) {
+        assert!(*b > 1e5 * a);
+    }
+    // Ignored: not finite, or not above the segment's own coordinates.
+    assert_eq!(
+        seg.clone().with_coordinate_scale(f64::NAN).c_floor(),
+        seg.c_floor()
+    );
+    assert_eq!(
+        seg.clone().with_coordinate_scale(1e-3).e_floor(),
+        seg.e_floor()
+    );
+}
+
+#[test]
+fn clean_dense_curve_is_left_alone() {
+    // A clean circle of 20 000 points far from the origin: han makes no move at all. (Its c
+    // in a bisector frame is convex with no vibration of e; a spiral's is not, and han moves
+    // a clean spiral a little.)
+    let n = 20_000;
+    let pts: Vec<Point> = (0..n)
+        .map(|i| {
+            let a = i as f64 * 1.9 * PI / n as f64;
+            Point::new(500.0 + 3.0 * a.cos(), -300.0 + 3.0 * a.sin())
+        })
+        .collect();
+    let input = PointSeq::open(pts.clone()).unwrap();
+    let out = fair::fair("han", &input, &FairOptions::default()).unwrap();
+    assert_eq!(out.report.status, FairStatus::NoChange);
+    assert_eq!(out.points, pts);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Partition and the curve pipeline
 // ---------------------------------------------------------------------------------------------
@@ -1322,12 +1411,15 @@ fn local_segments(pts: &[Point]) -> Vec<(han::Span, Vec<f64>, Vec<f64>)> {
         .collect()
 }
 
-/// An entry within a factor 100 of the zero threshold of §1.7.0: a sign test on it can go
-/// either way under rounding.
-fn near_threshold(v: &[f64]) -> bool {
+/// An entry within a factor 100 of the zero threshold of §1.7.0 or of its rounding-noise
+/// floor: a sign test on it can go either way under rounding (or under a rigid motion, which
+/// changes the coordinates' magnitude and so the floors).
+fn near_threshold(v: &[f64], floor: &[f64]) -> bool {
     let t = ZERO_REL * v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let near = |x: f64, t: f64| x.abs() >= t / 100.0 && x.abs() <= t * 100.0;
     v.iter()
-        .any(|x| x.abs() >= t / 100.0 && x.abs() <= t * 100.0)
+        .zip(floor)
+        .any(|(x, f)| near(*x, t) || near(*x, *f))
 }
 
 /// Run two segments that differ by rounding side by side. `Ok(true)`: identical moves and
@@ -1361,9 +1453,14 @@ fn same_run(mut a: Segment, mut b: Segment, iterations: usize, scale: f64) -> Re
                     s.displace(m.start, m.gammas()).unwrap();
                 }
             }
-            let edge = [a0.c(), a0.e(), b0.c(), b0.e()]
-                .iter()
-                .any(|v| near_threshold(v));
+            let edge = [
+                (a0.c(), a0.c_floor()),
+                (a0.e(), a0.e_floor()),
+                (b0.c(), b0.c_floor()),
+                (b0.e(), b0.e_floor()),
+            ]
+            .iter()
+            .any(|(v, f)| near_threshold(v, f));
             return if edge {
                 Ok(false)
             } else {
@@ -1456,8 +1553,14 @@ proptest! {
             }
             // The method's segment parameters (fine case 3 on).
             let method = SegmentParams::DEFAULT.with_fine_run3(han::DEFAULT_FINE_RUN3);
-            let seg = |x, y| Segment::new(x, y).and_then(|s| s.with_params(method));
-            if let (Ok(a), Ok(b)) = (seg(xa, ya), seg(xb, yb)) {
+            // With the floors `fair` uses: those of each input's coordinate magnitude.
+            let seg = |x, y, pts: &[Point]| {
+                let coord = batten::geom::max_abs_coordinate(pts);
+                Segment::new(x, y)
+                    .and_then(|s| s.with_params(method))
+                    .map(|s| s.with_coordinate_scale(coord))
+            };
+            if let (Ok(a), Ok(b)) = (seg(xa, ya, &pts), seg(xb, yb, &moved)) {
                 match same_run(a, b, han::DEFAULT_ITERATIONS, scale) {
                     Ok(same) => all_same &= same,
                     Err(e) => prop_assert!(false, "{}", e),

@@ -176,10 +176,7 @@ impl FairnessMetrics {
             kappa_seq.push(signed_curvature(&curve.derivatives_in_span(m - 1, t[m])));
         }
         // Rounding-noise floors of κ and dκ/ds (see NOISE_FACTOR).
-        let pts = seq.points();
-        let coord = pts
-            .iter()
-            .fold(0.0_f64, |a, p| a.max(p.x.abs()).max(p.y.abs()));
+        let coord = crate::geom::max_abs_coordinate(seq.points());
         let h_min = t.windows(2).fold(f64::INFINITY, |a, w| a.min(w[1] - w[0]));
         let kappa_floor = NOISE_FACTOR * f64::EPSILON * coord / (h_min * h_min);
         let dk_floor = kappa_floor / h_min;

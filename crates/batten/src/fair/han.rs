@@ -22,7 +22,12 @@
 //!   `c̃_1^2 = c̃_2^2`, `c̃_n^{n−1} = c̃_{n−1}^{n−1}` (\[FIX\], §1.6);
 //! - `e_1 = e_n = 0` (flat ends, \[CHOICE\] §1.5); sign tests with `sgn0` and
 //!   [`ZERO_REL`] `= 1e-12` relative to the largest |value| of the
-//!   current array (\[CHOICE\] §1.7.0);
+//!   current array (\[CHOICE\] §1.7.0), and also values within [`ROUNDING_FLOOR_FACTOR`]
+//!   times the noise that rounding the coordinates puts into c and e counted as 0 (\[CHOICE\],
+//!   not in the spec: on densely sampled data every e is rounding noise, which a relative test
+//!   cannot recognise; see [`Segment::c_floor`]). The floors depend on the coordinates'
+//!   magnitude, so a translation can change a sign test on a value at its floor, as rounding
+//!   can at the relative threshold;
 //! - coarse case 2 end rule `e_2 e_3 < 0 ∧ e_2 e_4 < 0` and its mirror (\[CHOICE/FIX\] §1.7.1);
 //! - coarse case 3 end rule with `e_2 e_4 < 0`, `e_2 e_5 < 0` (\[FIX\] §1.7.1);
 //! - fine-phase α rule: a fifth of the smaller-magnitude neighbour, left on a tie (\[CHOICE\]
@@ -61,8 +66,9 @@
 //! The segments of a pass are faired in parallel (rayon); blending and the report follow the
 //! curve's order, so the result does not depend on the number of threads.
 //! Measured (release, `benches/han.rs`, the spiral with a 1 % wobble): see `BENCHMARKS.md`;
-//! about 0.25 s for 10⁵ points and 2.5 s for 10⁶ on 2 cores with the default 3 passes × 10
-//! iterations (2 s without fine case 3), some 17 million moves at 10⁶.
+//! about 0.2 s for 10⁵ points and 2 s for 10⁶ on 2 cores with the default 3 passes × 10
+//! iterations, some 16 million moves at 10⁶. The cost is linear in the sweeps (10⁶ points:
+//! 1.0 s for one pass of 10 iterations, 1.1 s for 3 × 3).
 //!
 //! # Common options
 //!
@@ -97,7 +103,7 @@ use super::{FairMethod, FairStatus, HistoryRow, Move, Outcome, ParamSpec, clamp_
 use crate::analysis::{ZERO_REL, count_sign_changes, sgn0};
 use crate::error::{Error, Result};
 use crate::fair::FairOptions;
-use crate::geom::{Point, PointSeq, Vec2};
+use crate::geom::{Point, PointSeq, Vec2, max_abs_coordinate};
 use crate::spline::{CubicSplineFn, FnEndCondition};
 
 /// Default damping of coarse case 1, `λ_c` \[PAPER\].
@@ -135,6 +141,16 @@ pub const MIN_SEGMENT_POINTS: usize = 5;
 /// fraction of its largest entry. Below half an ulp of the largest change, so the truncated
 /// update equals eq 13 to rounding.
 pub const RESPONSE_CUTOFF_REL: f64 = 1e-17;
+/// Rounding-noise floor of the sign tests \[CHOICE\]. Rounding the coordinates (magnitude R) to
+/// double precision puts noise of up to about `0.4·ε·R/h²` into c and `4·0.4·ε·R/h³` into e
+/// (measured on 10⁶ samples of a sine, offset by 100, with spacing h): on dense data every e,
+/// and the c near a true inflection, can be pure noise, which the spec's relative zero test
+/// (§1.7.0) cannot tell from signal. Values of c at most `F·ε·R/h²` and of e at most
+/// `4F·ε·R/h³` (h the shorter chord at the point) count as 0 in the sign tests, with this F
+/// — the factor of the curve metrics' floor. It changes nothing on data whose noise is above
+/// rounding; on a clean curve it keeps `han` from fairing rounding noise (a clean 10⁶-point
+/// spiral made 5.4 million moves without it, none with it).
+pub const ROUNDING_FLOOR_FACTOR: f64 = 64.0;
 /// A 2×2 system is treated as singular (the move is skipped) when `|det|` is at most this
 /// fraction of `|a11 a22| + |a12 a21|`. The systems of coarse case 3 and fine case 2 have
 /// condition numbers below 30 on sane grids (spec §1.7).
@@ -506,12 +522,12 @@ impl SignScale {
         }
     }
 
-    /// `sgn0(values[i], max |values|)`.
+    /// `sgn0(values[i], max |values|)`, and 0 when `|values[i]| ≤ floor[i]`.
     #[inline]
-    fn sign(&mut self, values: &[f64], i: usize) -> i8 {
+    fn sign(&mut self, values: &[f64], floor: &[f64], i: usize) -> i8 {
         let v = values[i];
         let a = v.abs();
-        if a <= ZERO_REL * self.lower {
+        if a <= ZERO_REL * self.lower || a <= floor[i] {
             return 0;
         }
         if a > ZERO_REL * self.upper {
@@ -790,6 +806,9 @@ pub struct Segment {
     resp: UnitResponses,
     c_scale: SignScale,
     e_scale: SignScale,
+    /// Rounding-noise floors of c and e per point ([`ROUNDING_FLOOR_FACTOR`]).
+    c_floor: Vec<f64>,
+    e_floor: Vec<f64>,
     params: SegmentParams,
     bounds: Option<(Vec<f64>, Vec<f64>)>,
     limited: bool,
@@ -820,6 +839,8 @@ impl Segment {
             e: vec![0.0; n],
             c_scale: SignScale::new(&c),
             e_scale: SignScale::new(&[]),
+            c_floor: Vec::new(),
+            e_floor: Vec::new(),
             c,
             resp,
             params: SegmentParams::DEFAULT,
@@ -828,7 +849,51 @@ impl Segment {
         };
         seg.refresh_e(1, n - 2);
         seg.e_scale = SignScale::new(&seg.e);
+        seg.set_floors(0.0);
         Ok(seg)
+    }
+
+    /// Declare that the points carry the rounding of coordinates of magnitude up to
+    /// `magnitude` (e.g. those of the whole curve, before the segment was moved into its
+    /// frame), not only of their own: the rounding-noise floors of the sign tests
+    /// ([`ROUNDING_FLOOR_FACTOR`]) are raised accordingly. A non-finite or negative value is
+    /// ignored.
+    pub fn with_coordinate_scale(mut self, magnitude: f64) -> Segment {
+        if magnitude.is_finite() && magnitude > 0.0 {
+            self.set_floors(magnitude);
+        }
+        self
+    }
+
+    /// The rounding-noise floors `F·ε·R/h²` of c and `4F·ε·R/h³` of e at each point, with R
+    /// the larger of `magnitude` and the segment's own largest coordinate, and h the shorter
+    /// of the point's two chords (\[CHOICE\], see [`ROUNDING_FLOOR_FACTOR`]).
+    fn set_floors(&mut self, magnitude: f64) {
+        let n = self.len();
+        let own = self
+            .x
+            .iter()
+            .chain(&self.y)
+            .fold(0.0_f64, |m, v| m.max(v.abs()));
+        let scale = ROUNDING_FLOOR_FACTOR * f64::EPSILON * own.max(magnitude);
+        self.c_floor = Vec::with_capacity(n);
+        self.e_floor = Vec::with_capacity(n);
+        for i in 0..n {
+            let left = if i > 0 {
+                self.x[i] - self.x[i - 1]
+            } else {
+                f64::INFINITY
+            };
+            let right = if i + 1 < n {
+                self.x[i + 1] - self.x[i]
+            } else {
+                f64::INFINITY
+            };
+            let h = left.min(right);
+            let c = scale / (h * h);
+            self.c_floor.push(c);
+            self.e_floor.push(4.0 * c / h);
+        }
     }
 
     /// Use other parameters.
@@ -903,6 +968,16 @@ impl Segment {
         &self.resp
     }
 
+    /// The rounding-noise floor of each `c_i` ([`ROUNDING_FLOOR_FACTOR`]).
+    pub fn c_floor(&self) -> &[f64] {
+        &self.c_floor
+    }
+
+    /// The rounding-noise floor of each `e_i` ([`ROUNDING_FLOOR_FACTOR`]).
+    pub fn e_floor(&self) -> &[f64] {
+        &self.e_floor
+    }
+
     /// The parameters in use.
     pub fn params(&self) -> SegmentParams {
         self.params
@@ -915,12 +990,12 @@ impl Segment {
 
     /// HAN's `Infl_num = #{i : c_i c_{i+1} < 0}` with the zero tolerance of §1.7.0.
     pub fn inflection_count(&self) -> usize {
-        count_strict_changes(&self.c, abs_max(&self.c))
+        count_strict_changes(&self.c, &self.c_floor, abs_max(&self.c))
     }
 
     /// HAN's `Vib_num = #{i : e_i e_{i+1} < 0}` with the zero tolerance of §1.7.0.
     pub fn vibration_count(&self) -> usize {
-        count_strict_changes(&self.e, abs_max(&self.e))
+        count_strict_changes(&self.e, &self.e_floor, abs_max(&self.e))
     }
 
     /// Run `iterations` iterations of [`Procedure::ITERATION`], calling `on_move` for every
@@ -1040,12 +1115,12 @@ impl Segment {
 
     #[inline]
     fn e_sign(&mut self, i: usize) -> i8 {
-        self.e_scale.sign(&self.e, i)
+        self.e_scale.sign(&self.e, &self.e_floor, i)
     }
 
     #[inline]
     fn c_sign(&mut self, i: usize) -> i8 {
-        self.c_scale.sign(&self.c, i)
+        self.c_scale.sign(&self.c, &self.c_floor, i)
     }
 
     /// `sgn0(u)·sgn0(v) < 0` on e.
@@ -1397,11 +1472,16 @@ impl Segment {
     }
 }
 
-/// `#{i : sgn0(v_i)·sgn0(v_{i+1}) < 0}`.
-fn count_strict_changes(v: &[f64], scale: f64) -> usize {
-    v.windows(2)
-        .filter(|w| sgn0(w[0], scale) * sgn0(w[1], scale) < 0)
-        .count()
+/// `#{i : sgn0(v_i)·sgn0(v_{i+1}) < 0}`, with values at or below their floor counted as 0.
+fn count_strict_changes(v: &[f64], floor: &[f64], scale: f64) -> usize {
+    let sign = |i: usize| {
+        if v[i].abs() <= floor[i] {
+            0
+        } else {
+            sgn0(v[i], scale)
+        }
+    };
+    (1..v.len()).filter(|&i| sign(i - 1) * sign(i) < 0).count()
 }
 
 /// Solve `[a11 a12; a21 a22] (s, t) = (r1, r2)` by Cramer's rule, `None` when singular.
@@ -1720,6 +1800,8 @@ struct PassCtx<'a> {
     params: &'a HanParams,
     tolerance: Option<f64>,
     pass: usize,
+    /// The largest coordinate magnitude of the input (for the rounding-noise floors).
+    coord: f64,
 }
 
 /// Fair one open sequence `cur` (whose input positions are `orig`) in place: partition with
@@ -1823,7 +1905,9 @@ fn fair_span(
         log.skipped.push((index_of(0), index_of(pts.len() - 1)));
         return Ok((pts.to_vec(), 0));
     }
-    let mut seg = Segment::new(xs.clone(), ys.clone())?.with_params(ctx.params.segment)?;
+    let mut seg = Segment::new(xs.clone(), ys.clone())?
+        .with_params(ctx.params.segment)?
+        .with_coordinate_scale(ctx.coord);
     if let Some(d) = ctx.tolerance {
         // Moving along v keeps X; the point stays within d of its input position o while
         // (Y − o_y)² ≤ d² − (X − o_x)².
@@ -1851,11 +1935,8 @@ fn fair_span(
 }
 
 /// The tolerance actually enforced: a hair below the one asked for, so that rounding in the
-/// frame changes cannot exceed it.
-fn effective_tolerance(d: f64, pts: &[Point]) -> f64 {
-    let coord = pts
-        .iter()
-        .fold(0.0_f64, |m, p| m.max(p.x.abs()).max(p.y.abs()));
+/// frame changes cannot exceed it. `coord` is the largest coordinate magnitude.
+fn effective_tolerance(d: f64, coord: f64) -> f64 {
     (d * (1.0 - TOLERANCE_SAFETY_REL) - TOLERANCE_SAFETY_ULPS * f64::EPSILON * coord).max(0.0)
 }
 
@@ -1902,7 +1983,8 @@ impl FairMethod for Han {
         let orig = input.points();
         let n = orig.len();
         let closed = input.is_closed();
-        let tolerance = options.tolerance.map(|d| effective_tolerance(d, orig));
+        let coord = max_abs_coordinate(orig);
+        let tolerance = options.tolerance.map(|d| effective_tolerance(d, coord));
         let mut cur = orig.to_vec();
         let mut log = RunLog::default();
         let mut history = Vec::with_capacity(params.passes);
@@ -1913,6 +1995,7 @@ impl FairMethod for Han {
                 params: &params,
                 tolerance,
                 pass: pass + 1,
+                coord,
             };
             let moves = if closed {
                 // Cut the cycle at a point that moves from pass to pass (see the module docs).
@@ -2054,6 +2137,7 @@ mod tests {
         let mut v: Vec<f64> = (0..n).map(|_| (next() % 2000) as f64 - 1000.0).collect();
         let mut sc = SignScale::new(&v);
         let mut checks = 0;
+        let no_floor = vec![0.0; n];
         for round in 0..5000 {
             let lo = next() as usize % n;
             let hi = (lo + next() as usize % 20).min(n - 1);
@@ -2072,7 +2156,7 @@ mod tests {
             for _ in 0..5 {
                 let i = next() as usize % n;
                 assert_eq!(
-                    sc.sign(&v, i),
+                    sc.sign(&v, &no_floor, i),
                     sgn0(v[i], exact),
                     "round {round}, index {i}"
                 );
@@ -2082,7 +2166,10 @@ mod tests {
         }
         assert!(sc.rescans < checks / 2, "{} rescans", sc.rescans);
         let mut zeros = SignScale::new(&[0.0, 0.0]);
-        assert_eq!(zeros.sign(&[0.0, 0.0], 1), 0);
+        assert_eq!(zeros.sign(&[0.0, 0.0], &[0.0, 0.0], 1), 0);
+        let mut floored = SignScale::new(&[1.0, 1e-3]);
+        assert_eq!(floored.sign(&[1.0, 1e-3], &[0.0, 1e-3], 1), 0);
+        assert_eq!(floored.sign(&[1.0, 1e-3], &[0.0, 0.5e-3], 1), 1);
     }
 
     #[test]

@@ -8,6 +8,6 @@ mod point;
 mod seq;
 mod transform;
 
-pub use point::{BBox, Point, Vec2};
+pub use point::{BBox, Point, Vec2, max_abs_coordinate};
 pub use seq::PointSeq;
 pub use transform::Rigid;

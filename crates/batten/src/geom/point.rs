@@ -332,6 +332,14 @@ impl BBox {
     }
 }
 
+/// The largest coordinate magnitude `max(|x|, |y|)` over `points` (0 for none): the scale of
+/// the rounding they carry, which the rounding-noise floors of the metrics and of `han` use.
+pub fn max_abs_coordinate(points: &[Point]) -> f64 {
+    points
+        .iter()
+        .fold(0.0_f64, |a, p| a.max(p.x.abs()).max(p.y.abs()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

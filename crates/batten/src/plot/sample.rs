@@ -270,10 +270,7 @@ fn inflections(curve: &ParametricCubic, seq: &PointSeq) -> (usize, Vec<f64>) {
         let d = curve.derivatives_in_span(m - 1, t[m]);
         samples.push((t[m], signed_curvature(&d)));
     }
-    let coord = seq
-        .points()
-        .iter()
-        .fold(0.0_f64, |a, p| a.max(p.x.abs()).max(p.y.abs()));
+    let coord = crate::geom::max_abs_coordinate(seq.points());
     let h_min = t.windows(2).fold(f64::INFINITY, |a, w| a.min(w[1] - w[0]));
     let floor = INFLECTION_NOISE_FACTOR * f64::EPSILON * coord / (h_min * h_min);
     let filtered = |k: f64| if k.abs() <= floor { 0.0 } else { k };
