@@ -5,6 +5,7 @@
 //! `GFI = Σ LFI_i`. The paper does not say where κ'' is evaluated; the exact κ'' of a cubic is a
 //! Dirac mass at the knots, so the spec's normative divided difference is used.
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 use super::signed_curvature;
@@ -32,7 +33,7 @@ pub struct FairnessIndicators {
 pub fn fairness_indicators(curve: &BSplineCurve) -> FairnessIndicators {
     let xi = curve.knots().greville(curve.degree());
     let kappa: Vec<f64> = xi
-        .iter()
+        .par_iter()
         .map(|&t| signed_curvature(&curve.derivatives(t)))
         .collect();
     let s = arc_lengths_at_sorted(curve, &xi);
@@ -50,13 +51,31 @@ pub fn fairness_indicators(curve: &BSplineCurve) -> FairnessIndicators {
 /// Arc length from the start of the domain to each of the increasing parameters `ts`, in one
 /// O(n) sweep: each piece between consecutive parameters (split at the breakpoints) is
 /// integrated once by Gauss–Legendre quadrature, instead of integrating from a span start
-/// for every parameter.
+/// for every parameter. The pieces are integrated in parallel, a block at a time, and summed
+/// in order, so the result is the same bit for bit with any number of threads.
 pub(crate) fn arc_lengths_at_sorted(curve: &BSplineCurve, ts: &[f64]) -> Vec<f64> {
     let gl = GaussLegendre::new(ARC_NODES);
     let bp = curve.breakpoints();
+    let piece = |(a, b): (f64, f64)| {
+        if curve.weights().is_some() {
+            gl.integrate(a, b, |x| curve.first_derivative(x).length_squared().sqrt())
+        } else {
+            // One span search per piece; the nodes are inside it.
+            let span = curve.find_span(0.5 * (a + b));
+            gl.integrate(a, b, |x| {
+                curve
+                    .first_derivative_in_span(span, x)
+                    .length_squared()
+                    .sqrt()
+            })
+        }
+    };
     let mut out = Vec::with_capacity(ts.len());
+    let mut pieces: Vec<(f64, f64)> = Vec::with_capacity(ARC_BLOCK + 8);
+    // The number of pieces up to each parameter of the block.
+    let mut ends: Vec<usize> = Vec::with_capacity(ARC_BLOCK + 8);
     let (mut pos, mut s, mut k) = (bp[0], 0.0, 0);
-    for &t in ts {
+    for (idx, &t) in ts.iter().enumerate() {
         while pos < t {
             while k + 1 < bp.len() && bp[k + 1] <= pos {
                 k += 1;
@@ -69,26 +88,35 @@ pub(crate) fn arc_lengths_at_sorted(curve: &BSplineCurve, ts: &[f64]) -> Vec<f64
             if end <= pos {
                 break;
             }
-            s += if curve.weights().is_some() {
-                gl.integrate(pos, end, |x| {
-                    curve.first_derivative(x).length_squared().sqrt()
-                })
-            } else {
-                // One span search per piece; the nodes are inside it.
-                let span = curve.find_span(0.5 * (pos + end));
-                gl.integrate(pos, end, |x| {
-                    curve
-                        .first_derivative_in_span(span, x)
-                        .length_squared()
-                        .sqrt()
-                })
-            };
+            pieces.push((pos, end));
             pos = end;
         }
-        out.push(s);
+        ends.push(pieces.len());
+        if pieces.len() >= ARC_BLOCK || idx + 1 == ts.len() {
+            let lengths: Vec<f64> = if pieces.len() >= 2 * ARC_MIN_PARALLEL {
+                pieces.par_iter().map(|&p| piece(p)).collect()
+            } else {
+                pieces.iter().map(|&p| piece(p)).collect()
+            };
+            let mut j = 0;
+            for &e in &ends {
+                for l in &lengths[j..e] {
+                    s += l;
+                }
+                j = e;
+                out.push(s);
+            }
+            pieces.clear();
+            ends.clear();
+        }
     }
     out
 }
+
+/// Pieces per block of [`arc_lengths_at_sorted`].
+const ARC_BLOCK: usize = 16_384;
+/// Below twice this many pieces a block is integrated on the calling thread.
+const ARC_MIN_PARALLEL: usize = 1024;
 
 /// Gauss–Legendre nodes per piece in [`arc_lengths_at_sorted`]: the speed of a spline span is
 /// smooth, and 8 nodes integrate it to rounding level on the pieces between Greville points.

@@ -1,5 +1,6 @@
 //! [`FairnessMetrics`]: the numbers every report carries (spec §0.3, §0.4, §4.4).
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 use super::curvature::{curvature_derivative, signed_curvature};
@@ -25,13 +26,92 @@ const SAMPLES_PER_SPAN: usize = 16;
 /// that over `h_min`, count as zero.
 const NOISE_FACTOR: f64 = 64.0;
 
+/// Spans per parallel work unit of [`FairnessMetrics::of_seq`]. Fixed, so that the sums (and
+/// so the numbers) do not depend on the number of threads.
+const SPANS_PER_CHUNK: usize = 4096;
+
+/// What [`FairnessMetrics::of_seq`] gathers over a chunk of consecutive spans.
+#[derive(Debug, Default)]
+struct SpanSums {
+    kappa: SignRuns,
+    dk: SignRuns,
+    max_curvature: f64,
+    /// Arc length of the chunk, and at each of its spans' starts from the chunk's start.
+    length: f64,
+    s_knots: Vec<f64>,
+    strain: f64,
+    variation: f64,
+}
+
+/// A sequence of values seen in order, kept as its runs of one sign: enough to count its sign
+/// changes exactly as [`count_sign_changes`] would on the values with those of magnitude at
+/// most `floor` set to zero, without storing the values. A run survives the relative zero of
+/// [`sgn0`] when its largest magnitude does. Sequences of consecutive pieces can be built
+/// apart (in parallel) and appended in order.
+#[derive(Clone, Debug, Default)]
+struct SignRuns {
+    /// `(sign, largest |v| of the run)`, adjacent runs of opposite sign.
+    runs: Vec<(i8, f64)>,
+}
+
+impl SignRuns {
+    /// Append `v`; values with `|v| ≤ floor` are zeros and skipped.
+    #[inline]
+    fn push(&mut self, v: f64, floor: f64) {
+        let a = v.abs();
+        if a <= floor {
+            return;
+        }
+        let sign = if v > 0.0 { 1 } else { -1 };
+        match self.runs.last_mut() {
+            Some((s, m)) if *s == sign => *m = m.max(a),
+            _ => self.runs.push((sign, a)),
+        }
+    }
+
+    /// Append the runs of the values that follow.
+    fn append(&mut self, later: SignRuns) {
+        for (sign, a) in later.runs {
+            match self.runs.last_mut() {
+                Some((s, m)) if *s == sign => *m = m.max(a),
+                _ => self.runs.push((sign, a)),
+            }
+        }
+    }
+
+    /// The sign changes (see [`count_sign_changes`]).
+    fn count(&self, cyclic: bool) -> usize {
+        let scale = self.runs.iter().fold(0.0_f64, |m, r| m.max(r.1));
+        let mut kept = self
+            .runs
+            .iter()
+            .filter(|r| sgn0(r.1, scale) != 0)
+            .map(|r| r.0);
+        let Some(first) = kept.next() else {
+            return 0;
+        };
+        let (mut n, mut last) = (0, first);
+        for s in kept {
+            if s != last {
+                n += 1;
+                last = s;
+            }
+        }
+        // The wrap from the last kept sign back to the first.
+        if cyclic && last != first {
+            n += 1;
+        }
+        n
+    }
+}
+
 /// [`count_sign_changes`] with values of magnitude at most `floor` also counted as zero.
 fn count_sign_changes_above(values: &[f64], cyclic: bool, floor: f64) -> usize {
-    let filtered: Vec<f64> = values
-        .iter()
-        .map(|&v| if v.abs() <= floor { 0.0 } else { v })
-        .collect();
-    count_sign_changes(&filtered, cyclic)
+    let mut runs = SignRuns::default();
+    for &v in values {
+        runs.push(v, floor);
+    }
+    runs.count(cyclic)
 }
 
 /// The sign of `v` with values within `ZERO_REL · scale` of zero counted as 0 (spec §1.7.0).
@@ -128,60 +208,85 @@ impl FairnessMetrics {
         let m = curve.num_spans();
         let t = curve.knots();
 
-        // One pass over the spans, evaluating each span's polynomial directly (no span search):
-        // inflections from the curvature at the knots and at the vertex of each span's
-        // quadratic `r'×r''`; extrema and max |κ| from dense samples with both one-sided limits
-        // at the knots; length and energies by Gauss–Legendre quadrature.
-        let gl = GaussLegendre::default();
-        let mut kappa_seq = Vec::with_capacity(2 * m + 1);
-        let mut dk_seq = Vec::with_capacity((SAMPLES_PER_SPAN + 1) * m);
-        let mut s_knots = Vec::with_capacity(m + 1);
-        let (mut max_curvature, mut length, mut strain, mut variation) = (0.0_f64, 0.0, 0.0, 0.0);
-        for i in 0..m {
-            let [_, a1, a2, a3] = curve.span_coeffs(i);
-            let h = t[i + 1] - t[i];
-            let d0 = curve.derivatives_in_span(i, t[i]);
-            kappa_seq.push(signed_curvature(&d0));
-            // cross(s) = 6(a2×a3) s² + 6(a1×a3) s + 2(a1×a2)
-            let qa = 6.0 * a2.cross(a3);
-            let qb = 6.0 * a1.cross(a3);
-            if qa != 0.0 {
-                let sv = -qb / (2.0 * qa);
-                if sv > 0.0 && sv < h {
-                    kappa_seq.push(signed_curvature(&curve.derivatives_in_span(i, t[i] + sv)));
-                }
-            }
-            for j in 0..=SAMPLES_PER_SPAN {
-                let tt = t[i] + h * j as f64 / SAMPLES_PER_SPAN as f64;
-                let d = curve.derivatives_in_span(i, tt);
-                max_curvature = max_curvature.max(signed_curvature(&d).abs());
-                dk_seq.push(curvature_derivative(&d));
-            }
-            s_knots.push(length);
-            let half = 0.5 * h;
-            let mid = t[i] + half;
-            for (x, w) in gl.nodes().iter().zip(gl.weights()) {
-                let d = curve.derivatives_in_span(i, mid + half * x);
-                let speed = d.d1.length_squared().sqrt();
-                let k = signed_curvature(&d);
-                let dk = curvature_derivative(&d);
-                let ws = w * half * speed;
-                length += ws;
-                strain += ws * k * k;
-                variation += ws * dk * dk;
-            }
-        }
-        s_knots.push(length);
-        if !closed {
-            kappa_seq.push(signed_curvature(&curve.derivatives_in_span(m - 1, t[m])));
-        }
         // Rounding-noise floors of κ and dκ/ds (see NOISE_FACTOR).
         let coord = crate::geom::max_abs_coordinate(seq.points());
         let h_min = t.windows(2).fold(f64::INFINITY, |a, w| a.min(w[1] - w[0]));
         let kappa_floor = NOISE_FACTOR * f64::EPSILON * coord / (h_min * h_min);
         let dk_floor = kappa_floor / h_min;
-        let inflections = count_sign_changes_above(&kappa_seq, closed, kappa_floor);
-        let curvature_extrema = count_sign_changes_above(&dk_seq, closed, dk_floor);
+
+        // One pass over the spans, evaluating each span's polynomial directly (no span search):
+        // inflections from the curvature at the knots and at the vertex of each span's
+        // quadratic `r'×r''`; extrema and max |κ| from dense samples with both one-sided limits
+        // at the knots; length and energies by Gauss–Legendre quadrature. The spans are cut
+        // into fixed chunks measured in parallel and joined in order, so the numbers do not
+        // depend on the thread count.
+        let gl = GaussLegendre::default();
+        let chunks: Vec<SpanSums> = (0..m.div_ceil(SPANS_PER_CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let spans = c * SPANS_PER_CHUNK..((c + 1) * SPANS_PER_CHUNK).min(m);
+                let mut r = SpanSums {
+                    s_knots: Vec::with_capacity(spans.len()),
+                    ..SpanSums::default()
+                };
+                for i in spans {
+                    let [_, a1, a2, a3] = curve.span_coeffs(i);
+                    let h = t[i + 1] - t[i];
+                    let d0 = curve.derivatives_in_span(i, t[i]);
+                    r.kappa.push(signed_curvature(&d0), kappa_floor);
+                    // cross(s) = 6(a2×a3) s² + 6(a1×a3) s + 2(a1×a2)
+                    let qa = 6.0 * a2.cross(a3);
+                    let qb = 6.0 * a1.cross(a3);
+                    if qa != 0.0 {
+                        let sv = -qb / (2.0 * qa);
+                        if sv > 0.0 && sv < h {
+                            let d = curve.derivatives_in_span(i, t[i] + sv);
+                            r.kappa.push(signed_curvature(&d), kappa_floor);
+                        }
+                    }
+                    for j in 0..=SAMPLES_PER_SPAN {
+                        let tt = t[i] + h * j as f64 / SAMPLES_PER_SPAN as f64;
+                        let d = curve.derivatives_in_span(i, tt);
+                        r.max_curvature = r.max_curvature.max(signed_curvature(&d).abs());
+                        r.dk.push(curvature_derivative(&d), dk_floor);
+                    }
+                    r.s_knots.push(r.length);
+                    let half = 0.5 * h;
+                    let mid = t[i] + half;
+                    for (x, w) in gl.nodes().iter().zip(gl.weights()) {
+                        let d = curve.derivatives_in_span(i, mid + half * x);
+                        let speed = d.d1.length_squared().sqrt();
+                        let k = signed_curvature(&d);
+                        let dk = curvature_derivative(&d);
+                        let ws = w * half * speed;
+                        r.length += ws;
+                        r.strain += ws * k * k;
+                        r.variation += ws * dk * dk;
+                    }
+                }
+                r
+            })
+            .collect();
+        let mut kappa_runs = SignRuns::default();
+        let mut dk_runs = SignRuns::default();
+        let mut s_knots = Vec::with_capacity(m + 1);
+        let (mut max_curvature, mut length, mut strain, mut variation) = (0.0_f64, 0.0, 0.0, 0.0);
+        for r in chunks {
+            kappa_runs.append(r.kappa);
+            dk_runs.append(r.dk);
+            max_curvature = max_curvature.max(r.max_curvature);
+            s_knots.extend(r.s_knots.iter().map(|s| length + s));
+            length += r.length;
+            strain += r.strain;
+            variation += r.variation;
+        }
+        s_knots.push(length);
+        if !closed {
+            let d = curve.derivatives_in_span(m - 1, t[m]);
+            kappa_runs.push(signed_curvature(&d), kappa_floor);
+        }
+        let inflections = kappa_runs.count(closed);
+        let curvature_extrema = dk_runs.count(closed);
 
         // Vibrations: jumps of dκ/ds at the knots where r''' jumps.
         let knots: Vec<usize> = if closed {
@@ -190,7 +295,7 @@ impl FairnessMetrics {
             (1..m).collect()
         };
         let jumps: Vec<f64> = knots
-            .iter()
+            .par_iter()
             .map(|&k| {
                 let right = curve.derivatives_in_span(k, t[k]);
                 let left = if k == 0 {
@@ -209,6 +314,7 @@ impl FairnessMetrics {
 
         let gfi = if closed {
             let kappa: Vec<f64> = (0..m)
+                .into_par_iter()
                 .map(|k| signed_curvature(&curve.derivatives_in_span(k, t[k])))
                 .collect();
             lfi_from_samples(&kappa, &s_knots[..m], Some(length))
@@ -278,4 +384,86 @@ pub fn displacement(a: &[Point], b: &[Point]) -> Result<Displacement> {
         }
     }
     Ok(d)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The reference: zero the values at or below the floor, then count.
+    fn reference(values: &[f64], cyclic: bool, floor: f64) -> usize {
+        let filtered: Vec<f64> = values
+            .iter()
+            .map(|&v| if v.abs() <= floor { 0.0 } else { v })
+            .collect();
+        count_sign_changes(&filtered, cyclic)
+    }
+
+    #[test]
+    fn sign_runs_count_as_the_values_do() {
+        let mut state = 99_u64;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for case in 0..2000 {
+            let n = (next() * 40.0) as usize;
+            // Magnitudes over many decades, so that both the floor and the relative zero bite.
+            let values: Vec<f64> = (0..n)
+                .map(|_| {
+                    let mag = 10f64.powf(-16.0 * next());
+                    let v = if next() < 0.5 { -mag } else { mag };
+                    if next() < 0.1 { 0.0 } else { v }
+                })
+                .collect();
+            let floor = if case % 3 == 0 {
+                0.0
+            } else {
+                10f64.powf(-14.0 * next())
+            };
+            let cut = (next() * (n as f64 + 1.0)) as usize;
+            for cyclic in [false, true] {
+                let expected = reference(&values, cyclic, floor);
+                assert_eq!(count_sign_changes_above(&values, cyclic, floor), expected);
+                // Built in two pieces and appended.
+                let (mut a, mut b) = (SignRuns::default(), SignRuns::default());
+                values[..cut].iter().for_each(|&v| a.push(v, floor));
+                values[cut..].iter().for_each(|&v| b.push(v, floor));
+                a.append(b);
+                assert_eq!(a.count(cyclic), expected, "case {case}, cut {cut}");
+            }
+        }
+    }
+
+    #[test]
+    fn metrics_do_not_depend_on_the_thread_count() {
+        // More spans than one chunk, so that the chunks are joined.
+        let n = 3 * SPANS_PER_CHUNK + 17;
+        let pts: Vec<Point> = (0..n)
+            .map(|i| {
+                let a = i as f64 * 0.01;
+                Point::new(
+                    a.cos() * (1.0 + 0.3 * a),
+                    a.sin() * (1.0 + 0.3 * a) + 1e-4 * (i % 7) as f64,
+                )
+            })
+            .collect();
+        for closed in [false, true] {
+            let seq = PointSeq::new(pts.clone(), closed).unwrap();
+            let one = rayon::ThreadPoolBuilder::new()
+                .num_threads(1)
+                .build()
+                .unwrap()
+                .install(|| FairnessMetrics::of_seq(&seq).unwrap());
+            let three = rayon::ThreadPoolBuilder::new()
+                .num_threads(3)
+                .build()
+                .unwrap()
+                .install(|| FairnessMetrics::of_seq(&seq).unwrap());
+            assert_eq!(one, three);
+            assert!(one.inflections > 0 && one.vibrations > 0);
+        }
+    }
 }
