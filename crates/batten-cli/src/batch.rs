@@ -28,7 +28,7 @@ use std::process::ExitCode;
 
 use anyhow::anyhow;
 use batten::FairOptions;
-use batten::fair::{self, FairMethod, FairReport};
+use batten::fair::{self, EndFix, FairMethod, FairReport};
 use batten::io::{self, Format, IoError, format_f64};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -63,9 +63,11 @@ pub struct BatchArgs {
     /// Largest distance any point may move, in data units
     #[arg(long, value_name = "D")]
     tolerance: Option<f64>,
-    /// Keep the first and last points where they are
-    #[arg(long)]
-    fix_ends: bool,
+    /// Keep the ends of an open curve: the end points (bare `--fix-ends`, or `=position`),
+    /// also the end tangents (`=tangent`) or also the end curvatures (`=curvature`)
+    #[arg(long, value_name = "WHAT", num_args = 0..=1, require_equals = true,
+          default_missing_value = "position", value_parser = input::parse_end_fix)]
+    fix_ends: Option<EndFix>,
     /// Upper bound on the method's iterations (its own unit: sweeps, moves or passes)
     #[arg(long, value_name = "N")]
     max_iterations: Option<usize>,
@@ -181,7 +183,12 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
         .unwrap_or_else(|| fair::default_method());
     let method = input::method(name)?;
     let params = input::parse_sets(&args.set)?;
-    let options = input::options(args.tolerance, args.fix_ends, args.max_iterations, params);
+    let options = input::options(
+        args.tolerance,
+        args.fix_ends.unwrap_or_default(),
+        args.max_iterations,
+        params,
+    );
     input::check(method, false, &options)?;
     let summary_format = match &args.summary {
         Some(path) => Some(summary_format(path)?),

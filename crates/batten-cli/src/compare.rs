@@ -10,7 +10,7 @@ use std::fmt::Write as _;
 use std::process::ExitCode;
 
 use anyhow::anyhow;
-use batten::fair::{self, FairMethod, FairReport};
+use batten::fair::{self, EndFix, FairMethod, FairReport};
 use batten::io::format_f64;
 use batten::{FairOptions, FairnessMetrics, Point, PointSeq};
 use rayon::prelude::*;
@@ -56,7 +56,12 @@ pub(crate) struct Row {
 /// of the table, and make the exit code 1 after it is printed.
 pub fn run(args: &CompareArgs) -> Result<ExitCode, Failure> {
     let methods = resolve(&args.methods)?;
-    let base = input::options(args.tolerance, args.fix_ends, None, BTreeMap::new());
+    let base = input::options(
+        args.tolerance,
+        args.fix_ends.unwrap_or_default(),
+        None,
+        BTreeMap::new(),
+    );
     base.validate().map_err(|e| Failure::from_batten("", e))?;
     let data = input::read(&args.input, args.closed)?;
     let name = args.input.display().to_string();
@@ -217,7 +222,11 @@ pub(crate) fn markdown(
         if seq.is_closed() { "closed" } else { "open" },
         base.tolerance
             .map_or_else(|| "none".to_string(), format_f64),
-        if base.fix_ends { ", ends fixed" } else { "" },
+        if base.fix_ends.is_fixed() {
+            format!(", ends fixed ({})", base.fix_ends)
+        } else {
+            String::new()
+        },
     );
     s.push_str("| Method | Infl | Vib | S_d/M_d | E_s | GFI | time |\n");
     s.push_str("| :-- | --: | --: | --: | --: | --: | --: |\n");
@@ -353,6 +362,7 @@ struct CompareJson<'a> {
     input: &'a str,
     tolerance: Option<f64>,
     fix_ends: bool,
+    fixed_ends: EndFix,
     before: &'a FairnessMetrics,
     rows: Vec<RowJson<'a>>,
 }
@@ -429,7 +439,8 @@ fn to_json<'a>(
     CompareJson {
         input: name,
         tolerance: base.tolerance,
-        fix_ends: base.fix_ends,
+        fix_ends: base.fix_ends.is_fixed(),
+        fixed_ends: base.fix_ends,
         before,
         rows,
     }

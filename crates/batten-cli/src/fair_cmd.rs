@@ -29,7 +29,12 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         .unwrap_or_else(|| fair::default_method());
     let method = input::method(name)?;
     let params = input::parse_sets(&args.set)?;
-    let options = input::options(args.tolerance, args.fix_ends, args.max_iterations, params);
+    let options = input::options(
+        args.tolerance,
+        args.fix_ends.unwrap_or_default(),
+        args.max_iterations,
+        params,
+    );
     input::check(method, args.closed, &options)?;
     Format::from_path(&args.output).map_err(Failure::usage)?;
     check_directory(&args.output)?;

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use anyhow::anyhow;
 use batten::FairOptions;
-use batten::fair::{self, FairMethod};
+use batten::fair::{self, EndFix, FairMethod};
 use batten::io::{self, PointData, ReadOptions};
 
 use crate::failure::Failure;
@@ -63,14 +63,23 @@ pub fn check(m: &dyn FairMethod, closed: bool, options: &FairOptions) -> Result<
     fair::check_options(m, closed, options).map_err(|e| Failure::from_batten("", e))
 }
 
+/// `--fix-ends=WHAT` (clap value parser).
+///
+/// # Errors
+/// A message naming the accepted values.
+pub fn parse_end_fix(s: &str) -> Result<EndFix, String> {
+    s.parse::<EndFix>()
+        .map_err(|_| format!("'{s}' is not one of position, tangent, curvature (or free)"))
+}
+
 /// Options from the common flags.
 pub fn options(
     tolerance: Option<f64>,
-    fix_ends: bool,
+    fix_ends: EndFix,
     max_iterations: Option<usize>,
     params: BTreeMap<String, String>,
 ) -> FairOptions {
-    let mut o = FairOptions::default().with_fix_ends(fix_ends);
+    let mut o = FairOptions::default().with_end_fix(fix_ends);
     o.tolerance = tolerance;
     o.max_iterations = max_iterations;
     o.params = params;

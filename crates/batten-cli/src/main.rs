@@ -25,6 +25,7 @@ mod report;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use batten::fair::EndFix;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 /// Fair planar curves: measure the curvature of the curve through a list of points, move the
@@ -91,9 +92,11 @@ struct FairArgs {
     /// Largest distance any point may move, in data units
     #[arg(long, value_name = "D")]
     tolerance: Option<f64>,
-    /// Keep the first and last points where they are
-    #[arg(long)]
-    fix_ends: bool,
+    /// Keep the ends of an open curve: the end points (bare `--fix-ends`, or `=position`),
+    /// also the end tangents (`=tangent`) or also the end curvatures (`=curvature`)
+    #[arg(long, value_name = "WHAT", num_args = 0..=1, require_equals = true,
+          default_missing_value = "position", value_parser = input::parse_end_fix)]
+    fix_ends: Option<EndFix>,
     /// Upper bound on the method's iterations (its own unit: sweeps, moves or passes)
     #[arg(long, value_name = "N")]
     max_iterations: Option<usize>,
@@ -139,9 +142,11 @@ struct CompareArgs {
     /// Output format
     #[arg(long, value_enum, default_value_t = TableFormat::Md)]
     format: TableFormat,
-    /// Keep the first and last points where they are
-    #[arg(long)]
-    fix_ends: bool,
+    /// Keep the ends of an open curve: the end points (bare `--fix-ends`, or `=position`),
+    /// also the end tangents (`=tangent`) or also the end curvatures (`=curvature`)
+    #[arg(long, value_name = "WHAT", num_args = 0..=1, require_equals = true,
+          default_missing_value = "position", value_parser = input::parse_end_fix)]
+    fix_ends: Option<EndFix>,
     /// The points form a closed curve
     #[arg(long)]
     closed: bool,

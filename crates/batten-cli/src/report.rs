@@ -11,6 +11,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use batten::fair::EndFix;
 use batten::io::{self, format_f64};
 use batten::plot::{PlotKind, PlotOptions, auto_comb_scale, render};
 use batten::{FairOptions, FairnessMetrics, PointSeq};
@@ -43,9 +44,11 @@ pub struct ReportArgs {
     /// Largest distance any point may move, in data units
     #[arg(long, value_name = "D")]
     tolerance: Option<f64>,
-    /// Keep the first and last points where they are
-    #[arg(long)]
-    fix_ends: bool,
+    /// Keep the ends of an open curve: the end points (bare `--fix-ends`, or `=position`),
+    /// also the end tangents (`=tangent`) or also the end curvatures (`=curvature`)
+    #[arg(long, value_name = "WHAT", num_args = 0..=1, require_equals = true,
+          default_missing_value = "position", value_parser = input::parse_end_fix)]
+    fix_ends: Option<EndFix>,
     /// The points form a closed curve
     #[arg(long)]
     closed: bool,
@@ -58,7 +61,12 @@ pub struct ReportArgs {
 /// (exit 1). Methods that fail are reported on the page and make the exit code 1.
 pub fn run(args: &ReportArgs) -> Result<ExitCode, Failure> {
     let methods = compare::resolve(&args.methods)?;
-    let base = input::options(args.tolerance, args.fix_ends, None, BTreeMap::new());
+    let base = input::options(
+        args.tolerance,
+        args.fix_ends.unwrap_or_default(),
+        None,
+        BTreeMap::new(),
+    );
     base.validate().map_err(|e| Failure::from_batten("", e))?;
     check_output(&args.output, &["html", "htm"], &[args.input.as_path()])?;
     let data = input::read(&args.input, args.closed)?;
@@ -164,7 +172,11 @@ fn page(
         if seq.is_closed() { "closed" } else { "open" },
         base.tolerance
             .map_or_else(|| "none".to_string(), format_f64),
-        if base.fix_ends { "; ends fixed" } else { "" },
+        if base.fix_ends.is_fixed() {
+            format!("; ends fixed ({})", base.fix_ends)
+        } else {
+            String::new()
+        },
         env!("CARGO_PKG_VERSION"),
     );
 

@@ -785,3 +785,61 @@ fn bundled_examples_are_valid_inputs() {
     }
     assert_eq!(n, 12, "six curves, noisy and truth");
 }
+
+/// `--fix-ends` alone is the position; `--fix-ends=tangent|curvature` holds more, and the
+/// report says what was held and what the ends did.
+#[test]
+fn fix_ends_levels() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = file(dir.path(), "in.csv", &noisy_sine(30));
+    let before = read_csv_points(&input);
+    for (flag, held, name) in [
+        ("--fix-ends", 1, "position"),
+        ("--fix-ends=position", 1, "position"),
+        ("--fix-ends=tangent", 2, "tangent"),
+        ("--fix-ends=curvature", 3, "curvature"),
+    ] {
+        for method in ["han", "mst", "kjellander"] {
+            let out = dir.path().join("out.csv");
+            let rep = dir.path().join("r.json");
+            // The bare flag must not take the input file as its value.
+            let o = batten(&[
+                "fair",
+                flag,
+                s(&input),
+                "-o",
+                s(&out),
+                "--method",
+                method,
+                "--report",
+                s(&rep),
+            ]);
+            assert_eq!(code(&o), 0, "{flag} {method}: {}", stderr(&o));
+            let after = read_csv_points(&out);
+            let n = before.len();
+            for i in (0..held).chain(n - held..n) {
+                assert_eq!(after[i], before[i], "{flag} {method}: point {i}");
+            }
+            let r = read_json(&rep);
+            assert_eq!(r["fixed_ends"], name);
+            assert_eq!(r["fix_ends"], true);
+            let angles = r["end_changes"]["tangent_angle"].as_array().unwrap();
+            assert_eq!(angles.len(), 2);
+            if held >= 2 {
+                assert!(
+                    angles.iter().all(|a| a.as_f64() == Some(0.0)),
+                    "{flag} {method}"
+                );
+            }
+        }
+    }
+    let out = dir.path().join("never.csv");
+    let o = batten(&["fair", s(&input), "-o", s(&out), "--fix-ends=sideways"]);
+    assert_eq!(code(&o), 2);
+    assert!(
+        stderr(&o).contains("position, tangent, curvature"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
+}

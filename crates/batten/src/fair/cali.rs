@@ -37,6 +37,9 @@
 //!   next candidate is tried. The paper has no explicit deviation bound (λ ∈ [0, 1] keeps the
 //!   convex-hull property), so without a tolerance nothing is refused.
 //! - `fix_ends`: always in effect, since `P_0` and `P_m` never move and the curve is clamped.
+//!   `--fix-ends=tangent` (`curvature`) also holds `P_1`, `P_{m−1}` (and `P_2`, `P_{m−2}`): a
+//!   move then changes only the control points of its window that are not held, which keeps
+//!   the curve's end tangents (curvatures).
 //! - `max_iterations`: the largest number of accepted moves, by default
 //!   [`MAX_MOVES_PER_POINT`] per input point.
 //!
@@ -200,6 +203,7 @@ impl FairMethod for Cali {
             degree,
             tolerance: options.tolerance,
             max_moves: options.iterations_or(MAX_MOVES_PER_POINT.saturating_mul(points.len())),
+            held_ends: options.fix_ends.held().max(1),
             use_cache: true,
         };
         run_cali(points, &settings)
@@ -214,6 +218,8 @@ struct Settings {
     degree: usize,
     tolerance: Option<f64>,
     max_moves: usize,
+    /// Control points held at each end (`--fix-ends`).
+    held_ends: usize,
     /// Reuse candidate results whose dependencies did not change (always on; off only in the
     /// unit test that checks the cache changes nothing).
     use_cache: bool,
@@ -240,7 +246,7 @@ fn run_cali(points: &[Point], s: &Settings) -> Result<Outcome> {
     ends[0] = points[0];
     ends[last] = points[last];
     let curve = curve.with_control_points(ends)?;
-    let mut state = LocalIndicators::new(&curve)?;
+    let mut state = LocalIndicators::new(&curve)?.with_held_ends(s.held_ends);
     let data = DataSamples::new(&curve, &params, points);
     let m = state.len() - 1;
     let p = s.degree;
@@ -622,6 +628,8 @@ pub struct LocalIndicators {
     lfi: Vec<f64>,
     gfi: f64,
     generation: u64,
+    /// Control points held at each end (at least `P_0` and `P_m`; `--fix-ends`).
+    held: usize,
 }
 
 impl LocalIndicators {
@@ -740,7 +748,16 @@ impl LocalIndicators {
             lfi: ind.lfi,
             gfi: ind.gfi,
             generation: 0,
+            held: 1,
         })
+    }
+
+    /// Hold `k` control points at each end (at least 1, `P_0` and `P_m`): 2 keeps the end
+    /// tangents of the curve and 3 its end curvatures. A move changes only the control points
+    /// of its window that are not held.
+    pub fn with_held_ends(mut self, k: usize) -> LocalIndicators {
+        self.held = k.max(1);
+        self
     }
 
     /// The number of control points, m + 1.
@@ -890,8 +907,8 @@ impl LocalIndicators {
         let m = self.len() - 1;
         Window {
             first: i - LOCAL_HALF_WIDTH,
-            lo: (i - LOCAL_HALF_WIDTH).max(1),
-            hi: (i + LOCAL_HALF_WIDTH).min(m - 1),
+            lo: (i - LOCAL_HALF_WIDTH).max(self.held),
+            hi: (i + LOCAL_HALF_WIDTH).min(m.saturating_sub(self.held)),
             pts: self.op.local_unchecked(&self.ctrl, i, lambda),
         }
     }
@@ -1068,6 +1085,7 @@ mod tests {
                 degree: 3,
                 tolerance: None,
                 max_moves: 400,
+                held_ends: 1,
                 use_cache: true,
             };
             let with = run_cali(&pts, &s).expect("cached run");

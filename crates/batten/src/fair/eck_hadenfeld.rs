@@ -91,6 +91,11 @@ pub struct EckHadenfeldParams {
     ///
     /// Default value: `false`.
     pub free_ends: bool,
+    /// Control points held at each end unless `free_ends`: 1 (the end points), 2 (also the
+    /// end tangents) or 3 (also the end curvatures); `--fix-ends=tangent` / `curvature`.
+    ///
+    /// Default value: 1.
+    pub held_ends: usize,
 }
 
 impl EckHadenfeldParams {
@@ -102,6 +107,7 @@ impl EckHadenfeldParams {
         max_iterations: DEFAULT_MAX_ITERATIONS,
         min_rel_decrease: DEFAULT_MIN_REL_DECREASE,
         free_ends: false,
+        held_ends: 1,
     };
 
     /// Set the order l.
@@ -138,6 +144,12 @@ impl EckHadenfeldParams {
     /// Free (or fix) the end control points.
     pub fn with_free_ends(mut self, free: bool) -> EckHadenfeldParams {
         self.free_ends = free;
+        self
+    }
+
+    /// Hold `k` control points at each end (see [`EckHadenfeldParams::held_ends`]).
+    pub fn with_held_ends(mut self, k: usize) -> EckHadenfeldParams {
+        self.held_ends = k;
         self
     }
 }
@@ -321,7 +333,10 @@ pub fn fair_curve(
     let original: Vec<Point> = curve.control_points().to_vec();
     let n = original.len();
     let mut d = original.clone();
-    let movable = movable_mask(n, params.free_ends);
+    let movable = movable_mask(
+        n,
+        local::held_control_points(params.free_ends, params.held_ends),
+    );
 
     // The clamped local optimum of j and the energy its move would remove.
     let best_move = |d: &[Point], j: usize| -> (Point, f64, bool) {
@@ -517,9 +532,10 @@ fn run_fitted(
         max_iterations: options.iterations_or(DEFAULT_MAX_ITERATIONS),
         min_rel_decrease: DEFAULT_MIN_REL_DECREASE,
         free_ends: fitted.free_ends,
+        held_ends: fitted.held_ends,
     };
     let (faired, report) = fair_curve(&fitted.curve, &params)?;
-    let points = local::output_points(&faired, &fitted, input, options.fix_ends);
+    let points = local::output_points(&faired, &fitted, input, options.fix_ends.is_fixed());
     let mut parameters = fitted.parameters.clone();
     parameters.insert("order".into(), Value::from(params.order));
     parameters.insert("tabu".into(), params.tabu_length.into());

@@ -73,6 +73,8 @@
 //! # Common options
 //!
 //! - **Ends.** The paper fixes `P_1` and `P_N` and so does `han`, whatever `fix_ends` says.
+//!   `--fix-ends=tangent` (`curvature`) also holds the second (and third) point at each end
+//!   of an open curve: they get zero-width bounds, so a move that would shift one is not made.
 //! - **Tolerance.** A hard bound: every move is scaled back (as a whole, keeping its shape) so
 //!   that no point leaves the disc of radius D around its *input* position; blending is a convex
 //!   combination, which keeps points inside the disc.
@@ -1802,6 +1804,10 @@ struct PassCtx<'a> {
     pass: usize,
     /// The largest coordinate magnitude of the input (for the rounding-noise floors).
     coord: f64,
+    /// Points of the (open) input held at each end by `--fix-ends` beyond the first and the
+    /// last, which han never moves: 0, 1 (tangent) or 2 (curvature); and the point count.
+    held: usize,
+    points: usize,
 }
 
 /// Fair one open sequence `cur` (whose input positions are `orig`) in place: partition with
@@ -1908,12 +1914,28 @@ fn fair_span(
     let mut seg = Segment::new(xs.clone(), ys.clone())?
         .with_params(ctx.params.segment)?
         .with_coordinate_scale(ctx.coord);
-    if let Some(d) = ctx.tolerance {
+    // Points held by --fix-ends (the second and third at each end of the curve).
+    let held = |k: usize| {
+        let g = index_of(k);
+        ctx.held > 0 && (g <= ctx.held || g + 1 + ctx.held >= ctx.points)
+    };
+    let any_held = ctx.held > 0 && (0..pts.len()).any(held);
+    if ctx.tolerance.is_some() || any_held {
         // Moving along v keeps X; the point stays within d of its input position o while
         // (Y − o_y)² ≤ d² − (X − o_x)².
         let mut lo = Vec::with_capacity(pts.len());
         let mut hi = Vec::with_capacity(pts.len());
         for (k, o) in orig.iter().enumerate() {
+            if held(k) {
+                lo.push(ys[k]);
+                hi.push(ys[k]);
+                continue;
+            }
+            let Some(d) = ctx.tolerance else {
+                lo.push(f64::NEG_INFINITY);
+                hi.push(f64::INFINITY);
+                continue;
+            };
             let (ox, oy) = ((*o - origin).dot(u), (*o - origin).dot(v));
             let dx = xs[k] - ox;
             let r = (d * d - dx * dx).max(0.0).sqrt();
@@ -1996,6 +2018,12 @@ impl FairMethod for Han {
                 tolerance,
                 pass: pass + 1,
                 coord,
+                held: if closed {
+                    0
+                } else {
+                    options.fix_ends.held().saturating_sub(1)
+                },
+                points: n,
             };
             let moves = if closed {
                 // Cut the cycle at a point that moves from pass to pass (see the module docs).
@@ -2044,7 +2072,7 @@ impl FairMethod for Han {
                 notes.push(format!("{pulled} points were pulled back to the tolerance"));
             }
         }
-        if !closed && !options.fix_ends {
+        if !closed && !options.fix_ends.is_fixed() {
             notes.push("han keeps the end points fixed (as the paper does)".into());
         }
         if closed && params.passes == 1 {

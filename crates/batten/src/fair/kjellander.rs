@@ -63,8 +63,9 @@
 //! [`RETRY_CHANGE_REL`].
 //!
 //! **Ends.** The end points of an open curve are never bad points (`J` is defined at interior
-//! points only), so they never move: `--fix-ends` holds without any extra work. A closed
-//! curve has no ends and `fix_ends` has no effect on it.
+//! points only), so they never move: `--fix-ends` holds without any extra work. With
+//! `--fix-ends=tangent` (`curvature`) the second (and third) point at each end are not
+//! candidates either. A closed curve has no ends and `fix_ends` has no effect on it.
 //!
 //! # Hermite data
 //!
@@ -763,6 +764,8 @@ pub(super) fn drive(
 struct SplineState {
     rule: KpRule,
     closed: bool,
+    /// Points held at each end of an open curve (at least the end point; `--fix-ends`).
+    held: usize,
     /// Recompute the parameter steps from the chords after each move (chord-length only).
     reparametrize: bool,
     r: Vec<Point>,
@@ -803,6 +806,7 @@ impl SplineState {
         let mut s = SplineState {
             rule,
             closed,
+            held: 1,
             reparametrize: chord && reparametrize,
             r: points.to_vec(),
             m: vec![Vec2::ZERO; n],
@@ -957,7 +961,7 @@ impl LocalProblem for SplineState {
     }
 
     fn is_candidate(&self, i: usize) -> bool {
-        self.closed || (i > 0 && i + 1 < self.n())
+        self.closed || (i >= self.held && i + self.held < self.n())
     }
 
     fn badness(&self, i: usize) -> f64 {
@@ -1060,7 +1064,12 @@ fn run_points(
     let (threshold, reparametrize) = point_params(uniform, options)?;
     let closed = input.is_closed();
     let mut state = SplineState::new(input.points(), closed, !uniform, reparametrize, rule)?;
-    let candidates = if closed { input.len() } else { input.len() - 2 };
+    state.held = options.fix_ends.held().max(1);
+    let candidates = if closed {
+        input.len()
+    } else {
+        input.len().saturating_sub(2 * state.held)
+    };
     let max_moves = move_limit(options, candidates);
     let driven = drive(&mut state, threshold, max_moves, options.tolerance)?;
     let mut parameters = driven_parameters(&driven, threshold, max_moves);
@@ -1104,6 +1113,8 @@ fn run_points(
 #[derive(Clone, Debug)]
 struct HermiteState {
     rule: KpRule,
+    /// Points held at each end (at least the end point; `--fix-ends`).
+    held: usize,
     t: Vec<f64>,
     r: Vec<Point>,
     m: Vec<Vec2>,
@@ -1134,7 +1145,7 @@ impl LocalProblem for HermiteState {
     }
 
     fn is_candidate(&self, i: usize) -> bool {
-        i > 0 && i + 1 < self.r.len()
+        i >= self.held && i + self.held < self.r.len()
     }
 
     fn badness(&self, i: usize) -> f64 {
@@ -1225,8 +1236,10 @@ pub fn fair_hermite(
     let threshold = Threshold::from_options(options)?;
     let n = points.len();
     let scale = BBox::from_points(points).map_or(0.0, |b| b.diagonal());
+    let held = options.fix_ends.held().max(1);
     let mut state = HermiteState {
         rule,
+        held,
         t: t.to_vec(),
         r: points.to_vec(),
         m: tangents.to_vec(),
@@ -1235,7 +1248,7 @@ pub fn fair_hermite(
         min_chord: MIN_CHORD_REL * scale,
         planned: (Vec2::ZERO, Vec2::ZERO),
     };
-    let max_moves = move_limit(options, n - 2);
+    let max_moves = move_limit(options, n.saturating_sub(2 * held));
     let driven = drive(&mut state, threshold, max_moves, options.tolerance)?;
     let parameters = driven_parameters(&driven, threshold, max_moves);
     Ok(Outcome {

@@ -112,7 +112,10 @@
 //!   the orientation and inflection rule, the curvature form at infinite ρ, the method's end
 //!   gradients (a full end chord instead of the paper's third,
 //!   [`DEFAULT_METHOD_GRADIENT_FRACTION`]), the valid-sample fit for an explicit degree on an
-//!   inflected design, and `fix_ends` by elimination.
+//!   inflected design, and `fix_ends` by elimination. With `--fix-ends=tangent` or
+//!   `curvature` every control point whose basis function is non-zero at a domain end is
+//!   held instead ([`ShapeConstraints::hold_end_derivatives`]), which keeps the end points,
+//!   tangents and curvatures of the quintic exactly.
 
 use std::sync::OnceLock;
 
@@ -836,6 +839,10 @@ pub struct ShapeConstraints<'a> {
     pub tolerance: Option<f64>,
     /// Keep the curve's end points at these positions (see the module docs).
     pub fix_ends: Option<(Point, Point)>,
+    /// Keep every control point whose basis function is non-zero at a domain end, so that the
+    /// curve's end points, tangents and curvatures stay exactly as they are
+    /// (`--fix-ends=tangent` / `curvature`; `fix_ends` is then not needed).
+    pub hold_end_derivatives: bool,
 }
 
 impl ShapeConstraints<'_> {
@@ -939,11 +946,24 @@ struct Layout {
 }
 
 impl Layout {
-    fn new(curve: &BSplineCurve, fix_ends: Option<(Point, Point)>) -> Result<Layout> {
+    fn new(
+        curve: &BSplineCurve,
+        fix_ends: Option<(Point, Point)>,
+        hold_end_derivatives: bool,
+    ) -> Result<Layout> {
         let n = curve.control_points().len();
         let mut roles = vec![Role::Fixed; n];
         let mut elim = Vec::new();
-        if let Some((p0, p1)) = fix_ends {
+        // Control points acting at a domain end, kept where they are.
+        let mut held = vec![false; n];
+        if hold_end_derivatives {
+            let (a, b) = curve.domain();
+            for u in [a, b] {
+                let first = curve.find_span(u) - curve.degree();
+                held[first..=first + curve.degree()].fill(true);
+            }
+        }
+        if let Some((p0, p1)) = fix_ends.filter(|_| !hold_end_derivatives) {
             let (a, b) = curve.domain();
             for (u, target) in [(a, p0), (b, p1)] {
                 let span = curve.find_span(u);
@@ -987,7 +1007,7 @@ impl Layout {
         }
         let mut unknowns = 0;
         for (j, r) in roles.iter_mut().enumerate() {
-            if j != 0 && j != n - 1 && *r == Role::Fixed {
+            if j != 0 && j != n - 1 && *r == Role::Fixed && !held[j] {
                 *r = Role::Free(unknowns);
                 unknowns += 2;
             }
@@ -1128,7 +1148,11 @@ pub fn modify_shape(
             reason: "a tolerance needs anchor points".into(),
         });
     }
-    let layout = Layout::new(curve, constraints.fix_ends)?;
+    let layout = Layout::new(
+        curve,
+        constraints.fix_ends,
+        constraints.hold_end_derivatives,
+    )?;
     let mut q: Vec<Point> = curve.control_points().to_vec();
     for e in &layout.elim {
         e.apply(&mut q);
@@ -1724,7 +1748,7 @@ impl FairMethod for Kuragano {
             },
         };
         parameters.insert("degree".into(), json!(chosen));
-        let constrained = options.tolerance.is_some() || options.fix_ends;
+        let constrained = options.tolerance.is_some() || options.fix_ends.is_fixed();
         let reuse = reusable
             .get_mut(chosen - MIN_DEGREE)
             .and_then(Option::take)
@@ -1740,7 +1764,11 @@ impl FairMethod for Kuragano {
                 &ShapeConstraints {
                     anchors,
                     tolerance: options.tolerance,
-                    fix_ends: options.fix_ends.then(|| (points[0], points[m - 1])),
+                    fix_ends: options
+                        .fix_ends
+                        .is_fixed()
+                        .then(|| (points[0], points[m - 1])),
+                    hold_end_derivatives: options.fix_ends.held() >= 2,
                 },
             )?,
         };
@@ -1748,7 +1776,7 @@ impl FairMethod for Kuragano {
             .iter()
             .map(|&u| modification.curve.eval(u))
             .collect();
-        if options.fix_ends {
+        if options.fix_ends.is_fixed() {
             out[0] = points[0];
             out[m - 1] = points[m - 1];
         }

@@ -371,15 +371,22 @@ impl RunningMax {
     }
 }
 
-/// Movable control points: all but the first and last unless `free_ends` (spec §3 step 5:
-/// boundary control points are excluded, as the paper recommends).
-pub(crate) fn movable_mask(n_ctrl: usize, free_ends: bool) -> Vec<bool> {
+/// Movable control points: all but `held` at each end (spec §3 step 5: boundary control
+/// points are excluded, as the paper recommends; `held` is 0 with `free_ends`, 1 by default,
+/// 2 or 3 with `--fix-ends=tangent` / `curvature`, which keep the clamped curve's end tangents
+/// and curvatures).
+pub(crate) fn movable_mask(n_ctrl: usize, held: usize) -> Vec<bool> {
     let mut m = vec![true; n_ctrl];
-    if !free_ends && n_ctrl > 0 {
-        m[0] = false;
-        m[n_ctrl - 1] = false;
-    }
+    let held = held.min(n_ctrl);
+    m[..held].fill(false);
+    m[n_ctrl - held..].fill(false);
     m
+}
+
+/// Control points held at each end: none with `free_ends`, else those `--fix-ends` asks for
+/// (at least the end points).
+pub(crate) fn held_control_points(free_ends: bool, held_ends: usize) -> usize {
+    if free_ends { 0 } else { held_ends.max(1) }
 }
 
 /// δ of a library call: the given tolerance (checked positive and finite) or
@@ -478,6 +485,8 @@ pub(crate) struct FittedInput {
     pub delta: f64,
     /// Whether the first and last control points may move.
     pub free_ends: bool,
+    /// Control points held at each end when not `free_ends` (`--fix-ends`; at least 1).
+    pub held_ends: usize,
     /// Remarks for the report.
     pub notes: Vec<String>,
     /// Parameters as used.
@@ -520,10 +529,10 @@ pub(crate) fn fit_input(input: &PointSeq, options: &FairOptions) -> Result<Fitte
         .map(|(q, &t)| q.distance(curve.eval(t)))
         .fold(0.0, f64::max);
     let free = param_bool(options, "free_ends", false)?;
-    if free && options.fix_ends {
+    if free && options.fix_ends.is_fixed() {
         notes.push("free_ends is ignored because the ends are fixed (--fix-ends)".to_string());
     }
-    let free_ends = free && !options.fix_ends;
+    let free_ends = free && !options.fix_ends.is_fixed();
     let magnitude = points
         .iter()
         .chain(curve.control_points())
@@ -563,6 +572,7 @@ pub(crate) fn fit_input(input: &PointSeq, options: &FairOptions) -> Result<Fitte
         params,
         delta,
         free_ends,
+        held_ends: options.fix_ends.held().max(1),
         notes,
         parameters,
     })
@@ -587,7 +597,7 @@ pub(crate) fn curve_input(
     let seq = PointSeq::open(params.iter().map(|&t| curve.eval(t)).collect())?;
     let mut notes = Vec::new();
     let free = param_bool(options, "free_ends", false)?;
-    let free_ends = free && !options.fix_ends;
+    let free_ends = free && !options.fix_ends.is_fixed();
     let delta = match options.tolerance {
         Some(tol) => tol,
         None => {
@@ -611,6 +621,7 @@ pub(crate) fn curve_input(
             params,
             delta,
             free_ends,
+            held_ends: options.fix_ends.held().max(1),
             notes,
             parameters,
         },
@@ -733,7 +744,7 @@ mod tests {
     fn selection_skips_recent_and_clears_when_all_are_recent() {
         // Indices 0 and 5 (the largest) are boundary points.
         let dev = [9.0, 5.0, 7.0, 6.0, 8.0, 10.0];
-        let movable = movable_mask(6, false);
+        let movable = movable_mask(6, 1);
         let mut recent = RecentList::new(2);
         assert_eq!(select_candidate(&dev, &movable, &mut recent), Some(4));
         recent.push(4);
@@ -752,22 +763,22 @@ mod tests {
         assert!(recent.is_empty());
         // With free ends the boundary points compete too.
         assert_eq!(
-            select_candidate(&dev, &movable_mask(6, true), &mut recent),
+            select_candidate(&dev, &movable_mask(6, 0), &mut recent),
             Some(5)
         );
         // NaN ranks last; nothing movable gives None.
         let dev = [0.0, f64::NAN, 1.0, 0.0];
         assert_eq!(
-            select_candidate(&dev, &movable_mask(4, false), &mut RecentList::new(4)),
+            select_candidate(&dev, &movable_mask(4, 1), &mut RecentList::new(4)),
             Some(2)
         );
         let mut recent = RecentList::new(4);
         assert_eq!(
-            select_candidate(&[1.0, 2.0], &movable_mask(2, false), &mut recent),
+            select_candidate(&[1.0, 2.0], &movable_mask(2, 1), &mut recent),
             None
         );
         assert_eq!(
-            select_candidate(&[1.0, 2.0], &movable_mask(2, true), &mut recent),
+            select_candidate(&[1.0, 2.0], &movable_mask(2, 0), &mut recent),
             Some(1)
         );
     }

@@ -30,8 +30,8 @@ pub use han::Han;
 pub use kjellander::{
     Energy, HermiteMove, Kjellander, KpRule, Poliakoff, fair_hermite, hermite_step,
 };
-pub use options::{FairOptions, ParamSpec};
-pub use report::{FairReport, FairStatus, HistoryRow, Move};
+pub use options::{EndFix, FairOptions, ParamSpec};
+pub use report::{EndChanges, FairReport, FairStatus, HistoryRow, Move};
 pub use salvi::Salvi;
 pub use sapidis_farin::{SapidisFarin, remove_reinsert_knot};
 pub use smoothing::{Mst, Smoothing, SmoothingInfo, SmoothingSpline, SmoothingTrial};
@@ -229,8 +229,54 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
     check_options(m, input.is_closed(), options)?;
     let before = FairnessMetrics::of_seq(input)?;
     let start = Instant::now();
-    let outcome = m.run(input, options)?;
+    let held = options.fix_ends.held();
+    let outcome = if !input.is_closed() && 2 * held >= input.len() {
+        // Every point is held: nothing may move.
+        Outcome {
+            points: input.points().to_vec(),
+            status: FairStatus::NoChange,
+            iterations: 0,
+            moves: Vec::new(),
+            history: Vec::new(),
+            parameters: serde_json::Map::new(),
+            notes: vec![format!(
+                "--fix-ends={} holds {held} points at each end, so all {} points stay",
+                options.fix_ends,
+                input.len()
+            )],
+            curve: None,
+            tangents: None,
+        }
+    } else {
+        m.run(input, options)?
+    };
     finish(m, input, before, options, outcome, start)
+}
+
+/// The change of the discrete end tangents and curvatures from `input` to `output` (open
+/// curves of at least three points): the direction of the end chords and the signed
+/// curvature of the circle through the three end points.
+fn end_changes(input: &PointSeq, output: &PointSeq) -> Option<EndChanges> {
+    let (a, b) = (input.points(), output.points());
+    let n = a.len();
+    if input.is_closed() || n < 3 {
+        return None;
+    }
+    let angle = |u: Vec2, v: Vec2| u.cross(v).atan2(u.dot(v)).abs();
+    let menger = |p: Point, q: Point, r: Point| {
+        let (u, v, w) = (q - p, r - q, r - p);
+        2.0 * u.cross(v) / (u.length() * v.length() * w.length())
+    };
+    Some(EndChanges {
+        tangent_angle: [
+            angle(a[1] - a[0], b[1] - b[0]),
+            angle(a[n - 1] - a[n - 2], b[n - 1] - b[n - 2]),
+        ],
+        curvature: [
+            menger(b[0], b[1], b[2]) - menger(a[0], a[1], a[2]),
+            menger(b[n - 3], b[n - 2], b[n - 1]) - menger(a[n - 3], a[n - 2], a[n - 1]),
+        ],
+    })
 }
 
 /// Fair a B-spline curve with the method called `name` (B-spline in, B-spline out: knots and
@@ -284,6 +330,7 @@ fn finish(
     }
     let faired = input.with_points(outcome.points.clone())?;
     let after = FairnessMetrics::of_seq(&faired)?;
+    let end_changes = end_changes(input, &faired);
     let disp = displacement(input.points(), &outcome.points)?;
     let tolerance_met = options.tolerance.is_none_or(|d| disp.max <= d);
     let mut status = outcome.status;
@@ -307,7 +354,9 @@ fn finish(
         sum_displacement: disp.sum,
         tolerance: options.tolerance,
         tolerance_met,
-        fix_ends: options.fix_ends,
+        fix_ends: options.fix_ends.is_fixed(),
+        fixed_ends: options.fix_ends,
+        end_changes,
         before,
         after,
         elapsed_seconds: elapsed.as_secs_f64(),

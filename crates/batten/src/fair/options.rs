@@ -1,6 +1,89 @@
 use std::collections::BTreeMap;
+use std::fmt;
+use std::str::FromStr;
+
+use serde::Serialize;
 
 use crate::error::{Error, Result};
+
+/// What `--fix-ends` keeps at the two ends of an open curve: nothing, the end points
+/// (position, G0), also the end tangents (G1) or also the end curvatures (G2).
+///
+/// Methods that move points hold [`EndFix::held`] points at each end: 1 for the position, 2
+/// for the tangent (the end chord keeps its direction and length) and 3 for the curvature
+/// (also the circle through the three end points). Methods that move B-spline control points
+/// hold as many end control points, which keeps the clamped curve's end tangent and
+/// curvature exactly (`kuragano`, whose quintic is not clamped, holds every control point
+/// acting at an end). The report measures the discrete end tangents and curvatures
+/// ([`crate::fair::FairReport::end_changes`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EndFix {
+    /// The ends may move.
+    #[default]
+    Free,
+    /// The end points stay where they are.
+    Position,
+    /// The end points and end tangents are kept.
+    Tangent,
+    /// The end points, tangents and curvatures are kept.
+    Curvature,
+}
+
+impl EndFix {
+    /// Every value, loosest first.
+    pub const ALL: [EndFix; 4] = [
+        EndFix::Free,
+        EndFix::Position,
+        EndFix::Tangent,
+        EndFix::Curvature,
+    ];
+
+    /// True unless [`EndFix::Free`].
+    pub fn is_fixed(self) -> bool {
+        self != EndFix::Free
+    }
+
+    /// Points (or end control points) held at each end: 0, 1, 2 or 3.
+    pub fn held(self) -> usize {
+        match self {
+            EndFix::Free => 0,
+            EndFix::Position => 1,
+            EndFix::Tangent => 2,
+            EndFix::Curvature => 3,
+        }
+    }
+
+    /// The name used on the command line and in reports.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            EndFix::Free => "free",
+            EndFix::Position => "position",
+            EndFix::Tangent => "tangent",
+            EndFix::Curvature => "curvature",
+        }
+    }
+}
+
+impl fmt::Display for EndFix {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl FromStr for EndFix {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<EndFix> {
+        EndFix::ALL
+            .into_iter()
+            .find(|e| e.as_str() == s.trim())
+            .ok_or_else(|| Error::InvalidParameter {
+                name: "fix_ends".into(),
+                reason: format!("'{s}' is not one of free, position, tangent, curvature"),
+            })
+    }
+}
 
 /// Options common to every fairing method, plus the method's own parameters.
 ///
@@ -14,10 +97,10 @@ pub struct FairOptions {
     ///
     /// Default value: `None`.
     pub tolerance: Option<f64>,
-    /// Keep the first and last points (of an open curve) exactly where they are.
+    /// What to keep at the ends of an open curve ([`EndFix`]).
     ///
-    /// Default value: `false`.
-    pub fix_ends: bool,
+    /// Default value: [`EndFix::Free`].
+    pub fix_ends: EndFix,
     /// Upper bound on the method's iterations (its unit: sweeps, moves or passes).
     /// `None`: the method's own default.
     ///
@@ -35,7 +118,7 @@ impl FairOptions {
     /// parameters.
     pub const DEFAULT: FairOptions = FairOptions {
         tolerance: None,
-        fix_ends: false,
+        fix_ends: EndFix::Free,
         max_iterations: None,
         params: BTreeMap::new(),
     };
@@ -46,8 +129,14 @@ impl FairOptions {
         self
     }
 
-    /// Fix (or free) the end points.
+    /// Fix (or free) the end points: [`EndFix::Position`] or [`EndFix::Free`].
     pub fn with_fix_ends(mut self, fix: bool) -> FairOptions {
+        self.fix_ends = if fix { EndFix::Position } else { EndFix::Free };
+        self
+    }
+
+    /// Keep what `fix` says at the ends.
+    pub fn with_end_fix(mut self, fix: EndFix) -> FairOptions {
         self.fix_ends = fix;
         self
     }

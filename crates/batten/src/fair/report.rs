@@ -1,5 +1,6 @@
 use serde::Serialize;
 
+use super::EndFix;
 use crate::analysis::FairnessMetrics;
 
 /// How a fairing run ended (after OCCT's `FairCurve_AnalysisCode`).
@@ -47,6 +48,21 @@ pub struct HistoryRow {
     pub max_distance: f64,
 }
 
+/// The change at the two ends of an open curve, measured on the points: the discrete end
+/// tangent is the direction of the end chord and the discrete end curvature that of the
+/// circle through the three end points. Methods that move points keep both exactly with
+/// `--fix-ends=curvature` (zero here); methods that move B-spline control points keep the
+/// curve's end tangent and curvature exactly, and the data points next to the ends may then
+/// move a little, which shows here.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct EndChanges {
+    /// Angle between the old and the new end chord, in radians, at the start and the end.
+    pub tangent_angle: [f64; 2],
+    /// New minus old signed curvature of the circle through the three end points, at the
+    /// start and the end.
+    pub curvature: [f64; 2],
+}
+
 /// What a fairing run did. Serialised as the `--report` JSON.
 #[derive(Clone, Debug, Serialize)]
 pub struct FairReport {
@@ -72,6 +88,11 @@ pub struct FairReport {
     pub tolerance_met: bool,
     /// Whether the end points were fixed.
     pub fix_ends: bool,
+    /// What was kept at the ends ([`EndFix`]): `free`, `position`, `tangent` or `curvature`.
+    pub fixed_ends: EndFix,
+    /// How the discrete tangent and curvature at the two ends changed ([`EndChanges`]; open
+    /// curves of three or more points, `null` otherwise).
+    pub end_changes: Option<EndChanges>,
     /// Metrics of the input.
     pub before: FairnessMetrics,
     /// Metrics of the result.

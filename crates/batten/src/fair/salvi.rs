@@ -205,6 +205,11 @@ pub struct SalviParams {
     ///
     /// Default value: `false`.
     pub free_ends: bool,
+    /// Control points held at each end unless `free_ends`: 1 (the end points), 2 (also the
+    /// end tangents) or 3 (also the end curvatures); `--fix-ends=tangent` / `curvature`.
+    ///
+    /// Default value: 1.
+    pub held_ends: usize,
     /// Skip a control point whose last search made no progress (relative local improvement
     /// below [`STALL_REL_IMPROVEMENT`]) until a control point whose support overlaps its own
     /// makes progress; stop when every movable point is skipped. `false` follows spec §3 step 5
@@ -226,6 +231,7 @@ impl SalviParams {
         window: DEFAULT_WINDOW,
         min_rel_improvement: WINDOW_MIN_REL_IMPROVEMENT,
         free_ends: false,
+        held_ends: 1,
         skip_stalled: true,
     };
 
@@ -274,6 +280,12 @@ impl SalviParams {
     /// Free (or fix) the end control points.
     pub fn with_free_ends(mut self, free: bool) -> SalviParams {
         self.free_ends = free;
+        self
+    }
+
+    /// Hold `k` control points at each end (see [`SalviParams::held_ends`]).
+    pub fn with_held_ends(mut self, k: usize) -> SalviParams {
+        self.held_ends = k;
         self
     }
 
@@ -603,7 +615,10 @@ pub fn fair_curve(
     let measure_before: f64 = s.contrib.iter().sum();
     let mut measure = measure_before;
 
-    let movable = movable_mask(n_ctrl, params.free_ends);
+    let movable = movable_mask(
+        n_ctrl,
+        local::held_control_points(params.free_ends, params.held_ends),
+    );
     let mut recent = RecentList::new(params.tabu_length);
     let mut cur = curve.clone();
     let mut displacement = RunningMax::zeros(n_ctrl);
@@ -884,9 +899,10 @@ fn run_fitted(
     input: &PointSeq,
     options: &FairOptions,
 ) -> Result<Outcome> {
-    let params = salvi_params(options, Some(fitted.delta), fitted.free_ends)?;
+    let params = salvi_params(options, Some(fitted.delta), fitted.free_ends)?
+        .with_held_ends(fitted.held_ends);
     let (faired, report) = fair_curve(&fitted.curve, &params)?;
-    let points = local::output_points(&faired, &fitted, input, options.fix_ends);
+    let points = local::output_points(&faired, &fitted, input, options.fix_ends.is_fixed());
     let mut parameters = fitted.parameters.clone();
     parameters.insert("samples".into(), report.samples.len().into());
     parameters.insert(
@@ -969,6 +985,7 @@ fn salvi_params(
         window: options.param_usize_in("window", DEFAULT_WINDOW, 0, usize::MAX)?,
         min_rel_improvement: WINDOW_MIN_REL_IMPROVEMENT,
         free_ends,
+        held_ends: options.fix_ends.held().max(1),
         skip_stalled: true,
     })
 }

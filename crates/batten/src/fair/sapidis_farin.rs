@@ -70,7 +70,11 @@
 //! **Ends.** The interior knots are `u_4 … u_m`, so the moved control point is one of
 //! `P_2 … P_{m−2}`: `P_0, P_1, P_{m−1}, P_m` never move, and the first and last data points
 //! (which are `P_0` and `P_m` of the clamped curve, where every other basis function
-//! vanishes) never move. `--fix-ends` therefore holds by construction.
+//! vanishes) never move. `--fix-ends` therefore holds by construction, and so does
+//! `--fix-ends=tangent` for the curve (its end tangents are `3(P_1 − P_0)/Δu` and the mirror).
+//! `--fix-ends=curvature` also holds `P_2` and `P_{m−2}`, which keeps the curve's end
+//! curvatures; the data points next to the ends can still move a little (the report's
+//! `end_changes` measures the curve through the output points).
 //!
 //! Closed curves are rejected ([`Error::ClosedUnsupported`]): the spline module has no
 //! periodic B-spline interpolation yet.
@@ -182,6 +186,9 @@ struct KnotState {
     planned: (usize, Vec2),
     /// Data points in the support of the planned control point, with `N_c(t_k)`.
     affected: Vec<(usize, f64)>,
+    /// Control points held at each end (`--fix-ends`): the moved `P_{j−2}` must be at least
+    /// this far from both ends. Two always (`P_0, P_1` never move).
+    held: usize,
 }
 
 impl KnotState {
@@ -243,11 +250,10 @@ impl LocalProblem for KnotState {
     }
 
     fn is_candidate(&self, j: usize) -> bool {
-        is_simple_interior(
-            self.curve.knots().as_slice(),
-            self.curve.control_points().len(),
-            j,
-        )
+        let ncp = self.curve.control_points().len();
+        is_simple_interior(self.curve.knots().as_slice(), ncp, j)
+            && j >= 2 + self.held
+            && j + self.held <= ncp + 1
     }
 
     fn badness(&self, j: usize) -> f64 {
@@ -349,6 +355,7 @@ impl FairMethod for SapidisFarin {
             min_chord: MIN_CHORD_REL * scale,
             planned: (0, Vec2::ZERO),
             affected: Vec::new(),
+            held: options.fix_ends.held().max(2),
         };
         let interior = n.saturating_sub(DEGREE + 1);
         let max_moves = move_limit(options, interior);

@@ -34,7 +34,8 @@
 //! [`CyclicSymBanded`] (envelope `L D Lᵀ`, also O(n)) for closed ones.
 //!
 //! **Infinite weights** pin a point: `W⁻¹_ii = 0`, so `g_i = y_i` exactly. `fix_ends` pins the
-//! first and last points of an open curve. The matrix stays SPD because `R` is SPD for any
+//! first and last points of an open curve (and the second and third at each end for
+//! `--fix-ends=tangent` / `curvature`). The matrix stays SPD because `R` is SPD for any
 //! weights (and `p > 0`).
 //!
 //! **p = 0** (`α = ∞`) is the limit, solved directly: the weighted least-squares straight line
@@ -1040,13 +1041,16 @@ impl FairMethod for Mst {
             check_p(p, closed)?;
         }
         let mut notes = Vec::new();
-        let weights: Option<Vec<f64>> = if options.fix_ends && !closed {
+        let weights: Option<Vec<f64>> = if options.fix_ends.is_fixed() && !closed {
+            // Pin the held points at each end (one for the position, two for the tangent,
+            // three for the curvature).
+            let held = options.fix_ends.held().min(n / 2);
             let mut w = vec![1.0; n];
-            w[0] = f64::INFINITY;
-            w[n - 1] = f64::INFINITY;
+            w[..held].fill(f64::INFINITY);
+            w[n - held..].fill(f64::INFINITY);
             Some(w)
         } else {
-            if options.fix_ends {
+            if options.fix_ends.is_fixed() {
                 notes.push("fix_ends has no effect on a closed curve".to_string());
             }
             None
