@@ -579,13 +579,63 @@ fn closed_curves() {
         // Every point of a closed curve is a candidate, the first one included.
         assert!(r.after.vibrations <= r.before.vibrations, "{method}");
     }
-    let err = fair::fair("sapidis-farin", &input, &FairOptions::default()).unwrap_err();
-    assert_eq!(
-        err,
-        Error::ClosedUnsupported {
-            method: "sapidis-farin".into()
-        }
+}
+
+/// A closed curve for `sapidis-farin`: an ellipse with a fixed wobble.
+fn wobbly_ellipse(n: usize, shift: usize) -> Vec<Point> {
+    let pts: Vec<Point> = (0..n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            let r = 2.0 + 0.02 * (((i * 7) % 5) as f64 - 2.0);
+            Point::new(r * a.cos(), 1.3 * r * a.sin())
+        })
+        .collect();
+    (0..n).map(|i| pts[(i + shift) % n]).collect()
+}
+
+#[test]
+fn sapidis_farin_fairs_closed_curves_seam_free() {
+    let n = 48;
+    let input = PointSeq::closed(wobbly_ellipse(n, 0)).unwrap();
+    let opts = FairOptions::default().with_tolerance(0.05);
+    let out = fair::fair("sapidis-farin", &input, &opts).unwrap();
+    let r = &out.report;
+    assert!(r.moves.len() > 10, "{} moves", r.moves.len());
+    assert!(r.max_displacement <= 0.05);
+    assert!(
+        r.after.vibrations < r.before.vibrations,
+        "{:?}",
+        (r.before.vibrations, r.after.vibrations)
     );
+    assert!(r.history[r.history.len() - 1].measure < 0.2 * r.history[0].measure);
+    assert!(r.end_changes.is_none());
+    // Moves happen on both sides of the seam (point 0), which is not special.
+    let seam = r
+        .moves
+        .iter()
+        .filter(|m| m.index < 3 || m.index + 3 >= n)
+        .count();
+    assert!(seam > 0);
+    // The same curve listed from another start gives the same faired curve.
+    for shift in [1, 17, 47] {
+        let rotated = PointSeq::closed(wobbly_ellipse(n, shift)).unwrap();
+        let b = fair::fair("sapidis-farin", &rotated, &opts).unwrap();
+        for i in 0..n {
+            let d = b.points[i].distance(out.points[(i + shift) % n]);
+            assert!(d < 1e-9, "shift {shift}, point {i}: {d}");
+        }
+    }
+}
+
+#[test]
+fn sapidis_farin_needs_six_points_on_a_closed_curve() {
+    let few = PointSeq::closed(wobbly_ellipse(5, 0)).unwrap();
+    assert!(matches!(
+        fair::fair("sapidis-farin", &few, &FairOptions::default()),
+        Err(Error::TooFewPoints { needed: 6, got: 5 })
+    ));
+    let six = PointSeq::closed(wobbly_ellipse(6, 0)).unwrap();
+    assert!(fair::fair("sapidis-farin", &six, &FairOptions::default()).is_ok());
 }
 
 #[test]

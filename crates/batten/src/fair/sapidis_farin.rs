@@ -76,8 +76,13 @@
 //! curvatures; the data points next to the ends can still move a little (the report's
 //! `end_changes` measures the curve through the output points).
 //!
-//! Closed curves are rejected ([`Error::ClosedUnsupported`]): the spline module has no
-//! periodic B-spline interpolation yet.
+//! **Closed curves** use the periodic cubic through the points (chord-length parameters,
+//! knots at the parameters, a cyclic tridiagonal solve) in a wrapped form where every knot of
+//! the period is an interior knot ([`interpolate_closed`]): every knot is a candidate, a move
+//! changes every copy of its control point, and data points and chords are taken cyclically,
+//! so the seam is not special (listing the points from another start gives the same result).
+//! No B-spline is returned for a closed curve (the wrapped form is not a curve of its own).
+//! At least [`MIN_CLOSED_POINTS`] points.
 //!
 //! Cost: a move is local (one control point, five jumps, the few data points in the support
 //! of one basis function) and the bad knot is kept in a max-tree: O(log n) per move after
@@ -94,7 +99,8 @@ use super::{FairMethod, FairOptions, Outcome, ParamSpec};
 use crate::curve::Curve;
 use crate::error::{Error, Result};
 use crate::geom::{BBox, Point, PointSeq, Vec2};
-use crate::spline::{BSplineCurve, MAX_ORDER, Parametrization};
+use crate::numeric::solve_cyclic_tridiagonal;
+use crate::spline::{BSplineCurve, KnotVector, MAX_ORDER, Parametrization};
 
 /// The degree this method works with.
 const DEGREE: usize = 3;
@@ -313,6 +319,262 @@ impl LocalProblem for KnotState {
     }
 }
 
+/// Padding of the wrapped form of a periodic cubic: period knot `τ_m` is knot index
+/// `m + PAD`, so that every period knot is a simple interior knot with the whole Farin
+/// stencil (control points `j−4..=j`, knots `j−3..=j+3`) inside the wrapped curve.
+const PAD: usize = 4;
+
+/// The periodic (closed) cubic B-spline through `points` with chord-length parameters and
+/// knots at the data parameters, in a wrapped form: a [`BSplineCurve`] with `N + 4` control
+/// points `W_r = D_{(r−4) mod N}` (the last four repeat the first four) and knots
+/// `u_r = τ_{r−4}`, where `τ_k = t_{k mod N} + L·⌊k/N⌋` is the periodic extension of the
+/// parameters `t_0 = 0 < … < t_{N−1} < L`. Its domain `[τ_{−1}, τ_N]` covers one period.
+/// Returns the curve, the data parameters `t_k` and N.
+///
+/// # Errors
+/// [`Error::TooFewPoints`] below [`MIN_CLOSED_POINTS`]; duplicate or non-finite points; a
+/// singular interpolation system.
+fn interpolate_closed(points: &[Point]) -> Result<(BSplineCurve, Vec<f64>)> {
+    let n = points.len();
+    if n < MIN_CLOSED_POINTS {
+        return Err(Error::TooFewPoints {
+            needed: MIN_CLOSED_POINTS,
+            got: n,
+        });
+    }
+    let t = crate::spline::parameters(points, Parametrization::ChordLength, true)?;
+    let period = t[n];
+    let tau = |k: isize| {
+        let q = k.div_euclid(n as isize);
+        let r = k.rem_euclid(n as isize) as usize;
+        t[r] + period * q as f64
+    };
+    let knots: Vec<f64> = (0..n + PAD + 4)
+        .map(|r| tau(r as isize - PAD as isize))
+        .collect();
+    let knots = KnotVector::try_new(knots)?;
+    // Row k: N_{k−3}(τ_k) D_{k−3} + N_{k−2}(τ_k) D_{k−2} + N_{k−1}(τ_k) D_{k−1} = Q_k, in the
+    // unknowns x_i = D_{i−2} (cyclic tridiagonal).
+    let shape = BSplineCurve::try_new(DEGREE, knots.clone(), vec![Point::ORIGIN; n + PAD], None)?;
+    let (mut sub, mut diag, mut sup) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let mut b = [[0.0; MAX_ORDER]; 4];
+    for k in 0..n {
+        let span = k + PAD;
+        shape.basis_derivs(span, t[k], 0, &mut b);
+        sub[k] = b[0][0];
+        diag[k] = b[0][1];
+        sup[k] = b[0][2];
+    }
+    let mut x: Vec<Vec2> = points.iter().map(|p| p.to_vec2()).collect();
+    solve_cyclic_tridiagonal(&sub, &diag, &sup, &mut x)?;
+    // x_i = D_{i−2}, so D_d = x_{(d+2) mod N} and W_r = D_{(r−4) mod N} = x_{(r−2) mod N}.
+    let ctrl: Vec<Point> = (0..n + PAD)
+        .map(|r| x[(r + n - 2) % n].to_point())
+        .collect();
+    let curve = BSplineCurve::try_new(DEGREE, knots, ctrl, None)?;
+    Ok((curve, t[..n].to_vec()))
+}
+
+/// Fewest points of a closed curve for `sapidis-farin`: the support of a basis function
+/// (four spans) must be shorter than the period.
+pub const MIN_CLOSED_POINTS: usize = 6;
+
+/// The closed-curve counterpart of [`KnotState`], on the wrapped form of
+/// [`interpolate_closed`]: one candidate per period knot (indices `PAD..PAD + N`), every copy
+/// of a moved control point moved together, data points and chords taken cyclically.
+#[derive(Clone, Debug)]
+struct ClosedKnotState {
+    curve: BSplineCurve,
+    t: Vec<f64>,
+    q: Vec<Point>,
+    e: Vec<Vec2>,
+    disp: MaxTree,
+    min_chord: f64,
+    /// The distinct control point (index `d` of `D`) and its full move.
+    planned: (usize, Vec2),
+    affected: Vec<(usize, f64)>,
+}
+
+impl ClosedKnotState {
+    fn n(&self) -> usize {
+        self.q.len()
+    }
+
+    /// The wrapped indices of `D_d`.
+    fn copies(&self, d: usize) -> impl Iterator<Item = usize> + use<> {
+        let (n, len) = (self.q.len(), self.curve.control_points().len());
+        [d + PAD, d + PAD + n, (d + PAD).wrapping_sub(n)]
+            .into_iter()
+            .filter(move |&r| r < len)
+    }
+
+    /// `Σ_copies N_r(t_k)` for the data points in the support of some copy of `D_d`.
+    fn support_values(&mut self, d: usize) {
+        self.affected.clear();
+        let u = self.curve.knots().as_slice().to_vec();
+        let mut b = [[0.0; MAX_ORDER]; 4];
+        for r in self.copies(d).collect::<Vec<_>>() {
+            let (lo, hi) = (u[r], u[r + DEGREE + 1]);
+            let first = self.t.partition_point(|&x| x <= lo);
+            let last = self.t.partition_point(|&x| x < hi);
+            for k in first..last {
+                let tk = self.t[k];
+                let span = self.curve.find_span(tk);
+                if r + DEGREE < span || r > span {
+                    continue;
+                }
+                self.curve.basis_derivs(span, tk, 0, &mut b);
+                let v = b[0][r + DEGREE - span];
+                if v != 0.0 {
+                    match self.affected.iter_mut().find(|(i, _)| *i == k) {
+                        Some((_, w)) => *w += v,
+                        None => self.affected.push((k, v)),
+                    }
+                }
+            }
+        }
+    }
+
+    fn moved(&self, k: usize, s: f64) -> Point {
+        let w = self
+            .affected
+            .iter()
+            .find(|(i, _)| *i == k)
+            .map_or(0.0, |(_, v)| *v);
+        self.q[k] + self.e[k] + self.planned.1 * (s * w)
+    }
+
+    /// The representative (period) knot index of wrapped knot index `x`.
+    fn period_knot(&self, x: usize) -> usize {
+        let n = self.n();
+        PAD + (x + n - PAD % n) % n
+    }
+}
+
+impl LocalProblem for ClosedKnotState {
+    fn slots(&self) -> usize {
+        self.curve.knots().len()
+    }
+
+    fn is_candidate(&self, j: usize) -> bool {
+        (PAD..PAD + self.n()).contains(&j)
+    }
+
+    fn badness(&self, j: usize) -> f64 {
+        jump_norm(&self.curve, j)
+    }
+
+    fn plan(&mut self, j: usize, tolerance: Option<f64>) -> Option<f64> {
+        let c = j - 2;
+        let n = self.n();
+        let ctrl = self.curve.control_points();
+        let new = farin_point(ctrl, self.curve.knots().as_slice(), j);
+        let delta = new - ctrl[c];
+        if !delta.is_finite() {
+            return None;
+        }
+        let d = (c + n - PAD % n) % n;
+        self.planned = (d, delta);
+        self.support_values(d);
+        let s = match tolerance {
+            None => 1.0,
+            Some(tol) => {
+                let radius = tol * (1.0 - TOLERANCE_MARGIN);
+                self.affected
+                    .iter()
+                    .map(|&(k, w)| max_fraction(self.e[k], delta * w, radius))
+                    .fold(1.0, f64::min)
+            }
+        };
+        // Consecutive output points (cyclically) must stay distinct.
+        for &(k, _) in &self.affected {
+            for other in [(k + n - 1) % n, (k + 1) % n] {
+                if (self.moved(other, s) - self.moved(k, s)).length() < self.min_chord {
+                    return None;
+                }
+            }
+        }
+        Some(s)
+    }
+
+    fn commit(&mut self, _j: usize, s: f64, changed: &mut Vec<usize>) -> Result<(usize, f64)> {
+        let (d, delta) = self.planned;
+        let step = delta * s;
+        let copies: Vec<usize> = self.copies(d).collect();
+        let p = self.curve.control_points()[copies[0]] + step;
+        for &r in &copies {
+            self.curve.set_control_point(r, p);
+            // The jumps at the knots of the copy's support change.
+            for x in r..=r + DEGREE + 1 {
+                changed.push(self.period_knot(x));
+            }
+        }
+        for &(k, w) in &self.affected {
+            self.e[k] += step * w;
+            self.disp.set(k, self.e[k].length());
+        }
+        Ok((d, step.length()))
+    }
+
+    fn max_displacement(&self) -> f64 {
+        self.disp.max_value()
+    }
+}
+
+/// [`SapidisFarin::run`] on a closed curve.
+fn run_closed(points: &[Point], options: &FairOptions, threshold: Threshold) -> Result<Outcome> {
+    let (curve, t) = interpolate_closed(points)?;
+    let n = points.len();
+    let initial = curve.control_points().to_vec();
+    let scale = BBox::from_points(points).map_or(0.0, |b| b.diagonal());
+    let mut state = ClosedKnotState {
+        curve,
+        t,
+        q: points.to_vec(),
+        e: vec![Vec2::ZERO; n],
+        disp: MaxTree::zeros(n),
+        min_chord: MIN_CHORD_REL * scale,
+        planned: (0, Vec2::ZERO),
+        affected: Vec::new(),
+    };
+    let max_moves = move_limit(options, n);
+    let driven = drive(&mut state, threshold, max_moves, options.tolerance)?;
+    let mut parameters = driven_parameters(&driven, threshold, max_moves);
+    parameters.insert("degree".into(), json!(DEGREE));
+    parameters.insert("parametrization".into(), json!("chord-length"));
+    parameters.insert("knots".into(), json!("periodic, at the parameters"));
+    let delta: Vec<Point> = state
+        .curve
+        .control_points()
+        .iter()
+        .zip(&initial)
+        .map(|(p, p0)| (*p - *p0).to_point())
+        .collect();
+    let diff = state.curve.with_control_points(delta)?;
+    let out: Vec<Point> = state
+        .q
+        .iter()
+        .zip(&state.t)
+        .map(|(q, &t)| *q + diff.eval(t).to_vec2())
+        .collect();
+    let mut notes = driven.notes;
+    if options.fix_ends.is_fixed() {
+        notes.push("fix_ends has no effect on a closed curve".to_string());
+    }
+    Ok(Outcome {
+        points: out,
+        status: driven.status,
+        iterations: driven.moves.len(),
+        moves: driven.moves,
+        history: driven.history,
+        parameters,
+        notes,
+        // The wrapped form is not a clamped curve of its own; no B-spline is returned.
+        curve: None,
+        tangents: None,
+    })
+}
+
 impl FairMethod for SapidisFarin {
     fn name(&self) -> &'static str {
         "sapidis-farin"
@@ -327,7 +589,7 @@ impl FairMethod for SapidisFarin {
     }
 
     fn supports_closed(&self) -> bool {
-        false
+        true
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {
@@ -335,12 +597,10 @@ impl FairMethod for SapidisFarin {
     }
 
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
-        if input.is_closed() {
-            return Err(Error::ClosedUnsupported {
-                method: self.name().to_string(),
-            });
-        }
         let threshold = Threshold::from_options(options)?;
+        if input.is_closed() {
+            return run_closed(input.points(), options, threshold);
+        }
         let points = input.points();
         let (curve, t) = BSplineCurve::interpolate(points, DEGREE, Parametrization::ChordLength)?;
         let initial = curve.control_points().to_vec();
@@ -376,5 +636,40 @@ impl FairMethod for SapidisFarin {
             curve: Some(state.curve),
             tangents: None,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::curve::CurveDeriv;
+
+    #[test]
+    fn closed_interpolant_passes_through_the_points_and_is_periodic() {
+        let n = 11;
+        let pts: Vec<Point> = (0..n)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / n as f64 + 0.05 * (i % 3) as f64;
+                Point::new(2.0 * a.cos(), a.sin() + 0.1 * (2.0 * a).cos())
+            })
+            .collect();
+        let (curve, t) = interpolate_closed(&pts).unwrap();
+        assert_eq!(curve.control_points().len(), n + PAD);
+        for (k, &tk) in t.iter().enumerate() {
+            assert!(curve.eval(tk).distance(pts[k]) < 1e-12, "point {k}");
+        }
+        // One period on (τ_N = L, the domain end): the same point and derivatives, since
+        // the copies of the control points are consistent.
+        let period = curve.knots().as_slice()[n + PAD];
+        let a = curve.derivatives(t[0]);
+        let b = curve.derivatives_left(period);
+        assert!((a.point - b.point).length() < 1e-12);
+        assert!((a.d1 - b.d1).length() < 1e-9);
+        assert!((a.d2 - b.d2).length() < 1e-9);
+        // C² everywhere: no jump of the second derivative at any period knot.
+        for k in 1..n {
+            let (l, r) = (curve.derivatives_left(t[k]), curve.derivatives(t[k]));
+            assert!((l.d2 - r.d2).length() < 1e-9, "knot {k}");
+        }
     }
 }
