@@ -176,7 +176,10 @@ pub fn remove_reinsert_knot(curve: &BSplineCurve, j: usize) -> Result<BSplineCur
     curve.with_control_points(ctrl)
 }
 
-/// The interpolating cubic and the data it was built from, faired knot by knot.
+/// The interpolating cubic and the data it was built from, faired knot by knot. For a
+/// closed curve (`period = Some(N)`) the cubic is the wrapped form of [`interpolate_closed`]:
+/// one candidate per period knot (indices `PAD..PAD + N`), every copy of a moved control point
+/// moved together, data points and chords taken cyclically.
 #[derive(Clone, Debug)]
 struct KnotState {
     curve: BSplineCurve,
@@ -190,32 +193,59 @@ struct KnotState {
     min_chord: f64,
     /// Control point index and its full move.
     planned: (usize, Vec2),
-    /// Data points in the support of the planned control point, with `N_c(t_k)`.
+    /// Data points in the support of the planned control point, with `N_c(t_k)` (summed
+    /// over its copies on a closed curve).
     affected: Vec<(usize, f64)>,
     /// Control points held at each end (`--fix-ends`): the moved `P_{j−2}` must be at least
-    /// this far from both ends. Two always (`P_0, P_1` never move).
+    /// this far from both ends. Two always (`P_0, P_1` never move). Unused when closed.
     held: usize,
+    /// The number of points of a closed curve.
+    period: Option<usize>,
 }
 
 impl KnotState {
-    /// `N_c(t_k)` for the data points in the support of control point `c`.
+    /// The control point indices that hold the same control point as `c` (itself, and on a
+    /// closed curve its copies one period away).
+    fn copies(&self, c: usize) -> impl Iterator<Item = usize> + use<> {
+        let len = self.curve.control_points().len();
+        let (up, down) = match self.period {
+            Some(n) => (c + n, c.wrapping_sub(n)),
+            None => (usize::MAX, usize::MAX),
+        };
+        [c, up, down].into_iter().filter(move |&r| r < len)
+    }
+
+    /// The knot index that stands for knot `x` among the candidates.
+    fn candidate_knot(&self, x: usize) -> usize {
+        match self.period {
+            Some(n) => PAD + (x + n - PAD % n) % n,
+            None => x,
+        }
+    }
+
+    /// `N_c(t_k)` (summed over the copies of `c`) for the data points in its support.
     fn support_values(&mut self, c: usize) {
         self.affected.clear();
         let u = self.curve.knots().as_slice();
-        let (lo, hi) = (u[c], u[c + DEGREE + 1]);
-        let first = self.t.partition_point(|&x| x <= lo);
-        let last = self.t.partition_point(|&x| x < hi);
         let mut b = [[0.0; MAX_ORDER]; 4];
-        for k in first..last {
-            let tk = self.t[k];
-            let span = self.curve.find_span(tk);
-            if c + DEGREE < span || c > span {
-                continue;
-            }
-            self.curve.basis_derivs(span, tk, 0, &mut b);
-            let n = b[0][c + DEGREE - span];
-            if n != 0.0 {
-                self.affected.push((k, n));
+        for r in self.copies(c) {
+            let (lo, hi) = (u[r], u[r + DEGREE + 1]);
+            let first = self.t.partition_point(|&x| x <= lo);
+            let last = self.t.partition_point(|&x| x < hi);
+            for k in first..last {
+                let tk = self.t[k];
+                let span = self.curve.find_span(tk);
+                if r + DEGREE < span || r > span {
+                    continue;
+                }
+                self.curve.basis_derivs(span, tk, 0, &mut b);
+                let v = b[0][r + DEGREE - span];
+                if v != 0.0 {
+                    match self.affected.iter_mut().find(|(i, _)| *i == k) {
+                        Some((_, w)) => *w += v,
+                        None => self.affected.push((k, v)),
+                    }
+                }
             }
         }
     }
@@ -229,6 +259,28 @@ impl KnotState {
             .find(|(i, _)| *i == k)
             .map_or(0.0, |(_, n)| *n);
         self.q[k] + self.e[k] + d * (s * w)
+    }
+
+    /// Whether the planned fraction `s` keeps consecutive output points distinct.
+    fn chords_stay(&self, s: f64) -> bool {
+        let n = self.q.len();
+        let pairs: Vec<(usize, usize)> = match self.period {
+            Some(_) => self
+                .affected
+                .iter()
+                .flat_map(|&(k, _)| [((k + n - 1) % n, k), (k, (k + 1) % n)])
+                .collect(),
+            None => match (self.affected.first(), self.affected.last()) {
+                (Some(a), Some(b)) => {
+                    let (from, to) = (a.0.saturating_sub(1), (b.0 + 1).min(n - 1));
+                    (from..to).map(|k| (k, k + 1)).collect()
+                }
+                _ => Vec::new(),
+            },
+        };
+        pairs
+            .iter()
+            .all(|&(i, k)| (self.moved(k, s) - self.moved(i, s)).length() >= self.min_chord)
     }
 
     /// The output points: `Q_k + Σ_i N_i(t_k)(P_i − P_i⁰)`.
@@ -257,9 +309,14 @@ impl LocalProblem for KnotState {
 
     fn is_candidate(&self, j: usize) -> bool {
         let ncp = self.curve.control_points().len();
-        is_simple_interior(self.curve.knots().as_slice(), ncp, j)
-            && j >= 2 + self.held
-            && j + self.held <= ncp + 1
+        match self.period {
+            Some(n) => (PAD..PAD + n).contains(&j),
+            None => {
+                is_simple_interior(self.curve.knots().as_slice(), ncp, j)
+                    && j >= 2 + self.held
+                    && j + self.held <= ncp + 1
+            }
+        }
     }
 
     fn badness(&self, j: usize) -> f64 {
@@ -286,32 +343,27 @@ impl LocalProblem for KnotState {
             }
         };
         self.planned = (c, d);
-        // Consecutive output points must stay distinct.
-        let (first, last) = match (self.affected.first(), self.affected.last()) {
-            (Some(a), Some(b)) => (a.0, b.0),
-            _ => return Some(s),
-        };
-        let from = first.saturating_sub(1);
-        let to = (last + 1).min(self.q.len() - 1);
-        for k in from..to {
-            if (self.moved(k + 1, s) - self.moved(k, s)).length() < self.min_chord {
-                return None;
-            }
-        }
-        Some(s)
+        self.chords_stay(s).then_some(s)
     }
 
-    fn commit(&mut self, j: usize, s: f64, changed: &mut Vec<usize>) -> Result<(usize, f64)> {
+    fn commit(&mut self, _j: usize, s: f64, changed: &mut Vec<usize>) -> Result<(usize, f64)> {
         let (c, d) = self.planned;
         let step = d * s;
         let p = self.curve.control_points()[c] + step;
-        self.curve.set_control_point(c, p);
+        for r in self.copies(c) {
+            self.curve.set_control_point(r, p);
+            // The jumps at the knots of the support of P_r change.
+            for x in r..=r + DEGREE + 1 {
+                changed.push(self.candidate_knot(x));
+            }
+        }
         for &(k, n) in &self.affected {
             self.e[k] += step * n;
             self.disp.set(k, self.e[k].length());
         }
-        changed.extend(j.saturating_sub(2)..=j + 2);
-        Ok((c, step.length()))
+        // On a closed curve, the index of the distinct control point.
+        let index = self.period.map_or(c, |n| (c + n - PAD % n) % n);
+        Ok((index, step.length()))
     }
 
     fn max_displacement(&self) -> f64 {
@@ -379,155 +431,13 @@ fn interpolate_closed(points: &[Point]) -> Result<(BSplineCurve, Vec<f64>)> {
 /// (four spans) must be shorter than the period.
 pub const MIN_CLOSED_POINTS: usize = 6;
 
-/// The closed-curve counterpart of [`KnotState`], on the wrapped form of
-/// [`interpolate_closed`]: one candidate per period knot (indices `PAD..PAD + N`), every copy
-/// of a moved control point moved together, data points and chords taken cyclically.
-#[derive(Clone, Debug)]
-struct ClosedKnotState {
-    curve: BSplineCurve,
-    t: Vec<f64>,
-    q: Vec<Point>,
-    e: Vec<Vec2>,
-    disp: MaxTree,
-    min_chord: f64,
-    /// The distinct control point (index `d` of `D`) and its full move.
-    planned: (usize, Vec2),
-    affected: Vec<(usize, f64)>,
-}
-
-impl ClosedKnotState {
-    fn n(&self) -> usize {
-        self.q.len()
-    }
-
-    /// The wrapped indices of `D_d`.
-    fn copies(&self, d: usize) -> impl Iterator<Item = usize> + use<> {
-        let (n, len) = (self.q.len(), self.curve.control_points().len());
-        [d + PAD, d + PAD + n, (d + PAD).wrapping_sub(n)]
-            .into_iter()
-            .filter(move |&r| r < len)
-    }
-
-    /// `Σ_copies N_r(t_k)` for the data points in the support of some copy of `D_d`.
-    fn support_values(&mut self, d: usize) {
-        self.affected.clear();
-        let u = self.curve.knots().as_slice().to_vec();
-        let mut b = [[0.0; MAX_ORDER]; 4];
-        for r in self.copies(d).collect::<Vec<_>>() {
-            let (lo, hi) = (u[r], u[r + DEGREE + 1]);
-            let first = self.t.partition_point(|&x| x <= lo);
-            let last = self.t.partition_point(|&x| x < hi);
-            for k in first..last {
-                let tk = self.t[k];
-                let span = self.curve.find_span(tk);
-                if r + DEGREE < span || r > span {
-                    continue;
-                }
-                self.curve.basis_derivs(span, tk, 0, &mut b);
-                let v = b[0][r + DEGREE - span];
-                if v != 0.0 {
-                    match self.affected.iter_mut().find(|(i, _)| *i == k) {
-                        Some((_, w)) => *w += v,
-                        None => self.affected.push((k, v)),
-                    }
-                }
-            }
-        }
-    }
-
-    fn moved(&self, k: usize, s: f64) -> Point {
-        let w = self
-            .affected
-            .iter()
-            .find(|(i, _)| *i == k)
-            .map_or(0.0, |(_, v)| *v);
-        self.q[k] + self.e[k] + self.planned.1 * (s * w)
-    }
-
-    /// The representative (period) knot index of wrapped knot index `x`.
-    fn period_knot(&self, x: usize) -> usize {
-        let n = self.n();
-        PAD + (x + n - PAD % n) % n
-    }
-}
-
-impl LocalProblem for ClosedKnotState {
-    fn slots(&self) -> usize {
-        self.curve.knots().len()
-    }
-
-    fn is_candidate(&self, j: usize) -> bool {
-        (PAD..PAD + self.n()).contains(&j)
-    }
-
-    fn badness(&self, j: usize) -> f64 {
-        jump_norm(&self.curve, j)
-    }
-
-    fn plan(&mut self, j: usize, tolerance: Option<f64>) -> Option<f64> {
-        let c = j - 2;
-        let n = self.n();
-        let ctrl = self.curve.control_points();
-        let new = farin_point(ctrl, self.curve.knots().as_slice(), j);
-        let delta = new - ctrl[c];
-        if !delta.is_finite() {
-            return None;
-        }
-        let d = (c + n - PAD % n) % n;
-        self.planned = (d, delta);
-        self.support_values(d);
-        let s = match tolerance {
-            None => 1.0,
-            Some(tol) => {
-                let radius = tol * (1.0 - TOLERANCE_MARGIN);
-                self.affected
-                    .iter()
-                    .map(|&(k, w)| max_fraction(self.e[k], delta * w, radius))
-                    .fold(1.0, f64::min)
-            }
-        };
-        // Consecutive output points (cyclically) must stay distinct.
-        for &(k, _) in &self.affected {
-            for other in [(k + n - 1) % n, (k + 1) % n] {
-                if (self.moved(other, s) - self.moved(k, s)).length() < self.min_chord {
-                    return None;
-                }
-            }
-        }
-        Some(s)
-    }
-
-    fn commit(&mut self, _j: usize, s: f64, changed: &mut Vec<usize>) -> Result<(usize, f64)> {
-        let (d, delta) = self.planned;
-        let step = delta * s;
-        let copies: Vec<usize> = self.copies(d).collect();
-        let p = self.curve.control_points()[copies[0]] + step;
-        for &r in &copies {
-            self.curve.set_control_point(r, p);
-            // The jumps at the knots of the copy's support change.
-            for x in r..=r + DEGREE + 1 {
-                changed.push(self.period_knot(x));
-            }
-        }
-        for &(k, w) in &self.affected {
-            self.e[k] += step * w;
-            self.disp.set(k, self.e[k].length());
-        }
-        Ok((d, step.length()))
-    }
-
-    fn max_displacement(&self) -> f64 {
-        self.disp.max_value()
-    }
-}
-
 /// [`SapidisFarin::run`] on a closed curve.
 fn run_closed(points: &[Point], options: &FairOptions, threshold: Threshold) -> Result<Outcome> {
     let (curve, t) = interpolate_closed(points)?;
     let n = points.len();
     let initial = curve.control_points().to_vec();
     let scale = BBox::from_points(points).map_or(0.0, |b| b.diagonal());
-    let mut state = ClosedKnotState {
+    let mut state = KnotState {
         curve,
         t,
         q: points.to_vec(),
@@ -536,6 +446,8 @@ fn run_closed(points: &[Point], options: &FairOptions, threshold: Threshold) -> 
         min_chord: MIN_CHORD_REL * scale,
         planned: (0, Vec2::ZERO),
         affected: Vec::new(),
+        held: 0,
+        period: Some(n),
     };
     let max_moves = move_limit(options, n);
     let driven = drive(&mut state, threshold, max_moves, options.tolerance)?;
@@ -543,20 +455,7 @@ fn run_closed(points: &[Point], options: &FairOptions, threshold: Threshold) -> 
     parameters.insert("degree".into(), json!(DEGREE));
     parameters.insert("parametrization".into(), json!("chord-length"));
     parameters.insert("knots".into(), json!("periodic, at the parameters"));
-    let delta: Vec<Point> = state
-        .curve
-        .control_points()
-        .iter()
-        .zip(&initial)
-        .map(|(p, p0)| (*p - *p0).to_point())
-        .collect();
-    let diff = state.curve.with_control_points(delta)?;
-    let out: Vec<Point> = state
-        .q
-        .iter()
-        .zip(&state.t)
-        .map(|(q, &t)| *q + diff.eval(t).to_vec2())
-        .collect();
+    let out = state.output(&initial)?;
     let mut notes = driven.notes;
     if options.fix_ends.is_fixed() {
         notes.push("fix_ends has no effect on a closed curve".to_string());
@@ -616,6 +515,7 @@ impl FairMethod for SapidisFarin {
             planned: (0, Vec2::ZERO),
             affected: Vec::new(),
             held: options.fix_ends.held().max(2),
+            period: None,
         };
         let interior = n.saturating_sub(DEGREE + 1);
         let max_moves = move_limit(options, interior);
