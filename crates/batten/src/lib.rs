@@ -46,6 +46,6 @@ pub mod spline;
 pub use analysis::FairnessMetrics;
 pub use curve::{Curve, CurveDeriv, Derivatives, Piecewise};
 pub use error::{Error, Result};
-pub use fair::{FairOptions, FairReport, Faired};
+pub use fair::{EndFix, FairOptions, FairReport, Faired};
 pub use geom::PointSeq;
 pub use geom::{BBox, Point, Rigid, Vec2};
