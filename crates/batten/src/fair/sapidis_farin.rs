@@ -431,49 +431,6 @@ fn interpolate_closed(points: &[Point]) -> Result<(BSplineCurve, Vec<f64>)> {
 /// (four spans) must be shorter than the period.
 pub const MIN_CLOSED_POINTS: usize = 6;
 
-/// [`SapidisFarin::run`] on a closed curve.
-fn run_closed(points: &[Point], options: &FairOptions, threshold: Threshold) -> Result<Outcome> {
-    let (curve, t) = interpolate_closed(points)?;
-    let n = points.len();
-    let initial = curve.control_points().to_vec();
-    let scale = BBox::from_points(points).map_or(0.0, |b| b.diagonal());
-    let mut state = KnotState {
-        curve,
-        t,
-        q: points.to_vec(),
-        e: vec![Vec2::ZERO; n],
-        disp: MaxTree::zeros(n),
-        min_chord: MIN_CHORD_REL * scale,
-        planned: (0, Vec2::ZERO),
-        affected: Vec::new(),
-        held: 0,
-        period: Some(n),
-    };
-    let max_moves = move_limit(options, n);
-    let driven = drive(&mut state, threshold, max_moves, options.tolerance)?;
-    let mut parameters = driven_parameters(&driven, threshold, max_moves);
-    parameters.insert("degree".into(), json!(DEGREE));
-    parameters.insert("parametrization".into(), json!("chord-length"));
-    parameters.insert("knots".into(), json!("periodic, at the parameters"));
-    let out = state.output(&initial)?;
-    let mut notes = driven.notes;
-    if options.fix_ends.is_fixed() {
-        notes.push("fix_ends has no effect on a closed curve".to_string());
-    }
-    Ok(Outcome {
-        points: out,
-        status: driven.status,
-        iterations: driven.moves.len(),
-        moves: driven.moves,
-        history: driven.history,
-        parameters,
-        notes,
-        // The wrapped form is not a clamped curve of its own; no B-spline is returned.
-        curve: None,
-        tangents: None,
-    })
-}
-
 impl FairMethod for SapidisFarin {
     fn name(&self) -> &'static str {
         "sapidis-farin"
@@ -497,13 +454,17 @@ impl FairMethod for SapidisFarin {
 
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
         let threshold = Threshold::from_options(options)?;
-        if input.is_closed() {
-            return run_closed(input.points(), options, threshold);
-        }
         let points = input.points();
-        let (curve, t) = BSplineCurve::interpolate(points, DEGREE, Parametrization::ChordLength)?;
-        let initial = curve.control_points().to_vec();
         let n = points.len();
+        let closed = input.is_closed();
+        // Open: the clamped interpolant, P_0, P_1 (and more with --fix-ends) held. Closed: the
+        // wrapped periodic cubic, every knot of the period a candidate.
+        let (curve, t) = if closed {
+            interpolate_closed(points)?
+        } else {
+            BSplineCurve::interpolate(points, DEGREE, Parametrization::ChordLength)?
+        };
+        let initial = curve.control_points().to_vec();
         let scale = BBox::from_points(points).map_or(0.0, |b| b.diagonal());
         let mut state = KnotState {
             curve,
@@ -515,16 +476,31 @@ impl FairMethod for SapidisFarin {
             planned: (0, Vec2::ZERO),
             affected: Vec::new(),
             held: options.fix_ends.held().max(2),
-            period: None,
+            period: closed.then_some(n),
         };
-        let interior = n.saturating_sub(DEGREE + 1);
-        let max_moves = move_limit(options, interior);
+        let candidates = if closed {
+            n
+        } else {
+            n.saturating_sub(DEGREE + 1)
+        };
+        let max_moves = move_limit(options, candidates);
         let driven = drive(&mut state, threshold, max_moves, options.tolerance)?;
         let mut parameters = driven_parameters(&driven, threshold, max_moves);
         parameters.insert("degree".into(), json!(DEGREE));
         parameters.insert("parametrization".into(), json!("chord-length"));
-        parameters.insert("knots".into(), json!("averaging"));
+        parameters.insert(
+            "knots".into(),
+            json!(if closed {
+                "periodic, at the parameters"
+            } else {
+                "averaging"
+            }),
+        );
         let points = state.output(&initial)?;
+        let mut notes = driven.notes;
+        if closed && options.fix_ends.is_fixed() {
+            notes.push("fix_ends has no effect on a closed curve".to_string());
+        }
         Ok(Outcome {
             points,
             status: driven.status,
@@ -532,8 +508,9 @@ impl FairMethod for SapidisFarin {
             moves: driven.moves,
             history: driven.history,
             parameters,
-            notes: driven.notes,
-            curve: Some(state.curve),
+            notes,
+            // The wrapped form of a closed curve is not a curve of its own: none is returned.
+            curve: (!closed).then_some(state.curve),
             tangents: None,
         })
     }
