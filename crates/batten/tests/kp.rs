@@ -561,15 +561,7 @@ fn energy_position_mode_is_poliakoff() {
 
 #[test]
 fn closed_curves() {
-    let n = 48;
-    let pts: Vec<Point> = (0..n)
-        .map(|i| {
-            let a = std::f64::consts::TAU * i as f64 / n as f64;
-            let r = 2.0 + 0.02 * (((i * 7) % 5) as f64 - 2.0);
-            Point::new(r * a.cos(), 1.3 * r * a.sin())
-        })
-        .collect();
-    let input = PointSeq::closed(pts).unwrap();
+    let input = PointSeq::closed(wobbly_ellipse(48, 0)).unwrap();
     for method in KP_METHODS {
         let opts = FairOptions::default().with_max_iterations(200);
         let out = fair::fair(method, &input, &opts).unwrap();
@@ -581,7 +573,7 @@ fn closed_curves() {
     }
 }
 
-/// A closed curve for `sapidis-farin`: an ellipse with a fixed wobble.
+/// A closed curve: an ellipse with a fixed wobble, listed from point `shift`.
 fn wobbly_ellipse(n: usize, shift: usize) -> Vec<Point> {
     let pts: Vec<Point> = (0..n)
         .map(|i| {
