@@ -235,17 +235,12 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
         Outcome {
             points: input.points().to_vec(),
             status: FairStatus::NoChange,
-            iterations: 0,
-            moves: Vec::new(),
-            history: Vec::new(),
-            parameters: serde_json::Map::new(),
             notes: vec![format!(
                 "--fix-ends={} holds {held} points at each end, so all {} points stay",
                 options.fix_ends,
                 input.len()
             )],
-            curve: None,
-            tangents: None,
+            ..Outcome::default()
         }
     } else {
         m.run(input, options)?
