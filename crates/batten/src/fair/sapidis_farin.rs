@@ -78,7 +78,7 @@
 //!
 //! **Closed curves** use the periodic cubic through the points (chord-length parameters,
 //! knots at the parameters, a cyclic tridiagonal solve) in a wrapped form where every knot of
-//! the period is an interior knot ([`interpolate_closed`]): every knot is a candidate, a move
+//! the period is an interior knot (`interpolate_closed`): every knot is a candidate, a move
 //! changes every copy of its control point, and data points and chords are taken cyclically,
 //! so the seam is not special (listing the points from another start gives the same result).
 //! No B-spline is returned for a closed curve (the wrapped form is not a curve of its own).
