@@ -138,6 +138,10 @@ struct Row {
     strain_energy_after: Option<f64>,
     gfi_before: Option<f64>,
     gfi_after: Option<f64>,
+    /// The larger of the two end chords' turns (radians; open curves).
+    end_tangent_change: Option<f64>,
+    /// The larger |change| of the two end curvatures (open curves).
+    end_curvature_change: Option<f64>,
 }
 
 impl Row {
@@ -166,6 +170,12 @@ impl Row {
             strain_energy_after: report.map(|r| r.after.strain_energy),
             gfi_before: report.map(|r| r.before.gfi),
             gfi_after: report.map(|r| r.after.gfi),
+            end_tangent_change: report
+                .and_then(|r| r.end_changes)
+                .map(|e| e.tangent_angle[0].max(e.tangent_angle[1])),
+            end_curvature_change: report
+                .and_then(|r| r.end_changes)
+                .map(|e| e.curvature[0].abs().max(e.curvature[1].abs())),
         }
     }
 }
@@ -624,7 +634,8 @@ fn summary_csv(rows: &[Row]) -> String {
     let mut s = String::from(
         "file,status,error,points,iterations,max_displacement,sum_displacement,tolerance_met,\
          inflections_before,inflections_after,vibrations_before,vibrations_after,\
-         strain_energy_before,strain_energy_after,gfi_before,gfi_after\n",
+         strain_energy_before,strain_energy_after,gfi_before,gfi_after,end_tangent_change,\
+         end_curvature_change\n",
     );
     let int = |n: Option<usize>| n.map(|n| n.to_string()).unwrap_or_default();
     let num = |x: Option<f64>| x.map(csv_num).unwrap_or_default();
@@ -632,7 +643,7 @@ fn summary_csv(rows: &[Row]) -> String {
         // Writing to a String cannot fail.
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             csv_field(&r.file),
             r.status.name(),
             csv_field(r.error.as_deref().unwrap_or_default()),
@@ -649,6 +660,8 @@ fn summary_csv(rows: &[Row]) -> String {
             num(r.strain_energy_after),
             num(r.gfi_before),
             num(r.gfi_after),
+            num(r.end_tangent_change),
+            num(r.end_curvature_change),
         );
     }
     s

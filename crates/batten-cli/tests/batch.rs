@@ -205,7 +205,12 @@ fn mixed_directory_writes_good_files_and_reports_the_bad_one() {
         ] {
             assert!(row[key].as_f64().unwrap() > 0.0, "{key}: {row}");
         }
-        for key in ["gfi_before", "gfi_after"] {
+        for key in [
+            "gfi_before",
+            "gfi_after",
+            "end_tangent_change",
+            "end_curvature_change",
+        ] {
             assert!(row[key].as_f64().is_some(), "{key}: {row}");
         }
         for key in [
@@ -247,7 +252,9 @@ fn mixed_directory_writes_good_files_and_reports_the_bad_one() {
             "strain_energy_before",
             "strain_energy_after",
             "gfi_before",
-            "gfi_after"
+            "gfi_after",
+            "end_tangent_change",
+            "end_curvature_change"
         ]
     );
 
@@ -577,7 +584,8 @@ fn summary_csv_has_one_row_per_input_in_order() {
         Some(
             "file,status,error,points,iterations,max_displacement,sum_displacement,\
              tolerance_met,inflections_before,inflections_after,vibrations_before,\
-             vibrations_after,strain_energy_before,strain_energy_after,gfi_before,gfi_after"
+             vibrations_after,strain_energy_before,strain_energy_after,gfi_before,gfi_after,\
+             end_tangent_change,end_curvature_change"
         )
     );
     let rows: Vec<Vec<String>> = lines.map(csv_fields).collect();
@@ -592,7 +600,7 @@ fn summary_csv_has_one_row_per_input_in_order() {
         "g,\"h\".csv",
     ];
     for (row, n) in rows.iter().zip(order) {
-        assert_eq!(row.len(), 16, "{row:?}");
+        assert_eq!(row.len(), 18, "{row:?}");
         assert_eq!(row[0], s(&inp.join(n)));
     }
     let statuses: Vec<&str> = rows.iter().map(|r| r[1].as_str()).collect();
