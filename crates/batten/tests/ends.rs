@@ -220,6 +220,21 @@ fn closed_curves_have_no_end_changes() {
     let input = PointSeq::closed(pts).unwrap();
     let out = fair::fair("han", &input, &FairOptions::default()).unwrap();
     assert!(out.report.end_changes.is_none());
+    // Every method says, once, that fix_ends does nothing on a closed curve.
+    for method in ["han", "mst", "kjellander", "sapidis-farin"] {
+        let out = fair::fair(
+            method,
+            &input,
+            &FairOptions::default().with_end_fix(EndFix::Tangent),
+        )
+        .unwrap();
+        let said = out
+            .report
+            .notes
+            .iter()
+            .filter(|n| n.contains("fix_ends has no effect"));
+        assert_eq!(said.count(), 1, "{method}: {:?}", out.report.notes);
+    }
 }
 
 proptest! {

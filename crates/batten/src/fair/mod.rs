@@ -330,6 +330,9 @@ fn finish(
     let tolerance_met = options.tolerance.is_none_or(|d| disp.max <= d);
     let mut status = outcome.status;
     let mut notes = outcome.notes;
+    if input.is_closed() && options.fix_ends.is_fixed() {
+        notes.push("fix_ends has no effect on a closed curve (it has no ends)".to_string());
+    }
     if !tolerance_met {
         status = FairStatus::ToleranceExceeded;
         notes.push(format!(

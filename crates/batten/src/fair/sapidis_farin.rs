@@ -497,10 +497,6 @@ impl FairMethod for SapidisFarin {
             }),
         );
         let points = state.output(&initial)?;
-        let mut notes = driven.notes;
-        if closed && options.fix_ends.is_fixed() {
-            notes.push("fix_ends has no effect on a closed curve".to_string());
-        }
         Ok(Outcome {
             points,
             status: driven.status,
@@ -508,7 +504,7 @@ impl FairMethod for SapidisFarin {
             moves: driven.moves,
             history: driven.history,
             parameters,
-            notes,
+            notes: driven.notes,
             // The wrapped form of a closed curve is not a curve of its own: none is returned.
             curve: (!closed).then_some(state.curve),
             tangents: None,

@@ -1050,9 +1050,6 @@ impl FairMethod for Mst {
             w[n - held..].fill(f64::INFINITY);
             Some(w)
         } else {
-            if options.fix_ends.is_fixed() {
-                notes.push("fix_ends has no effect on a closed curve".to_string());
-            }
             None
         };
         let (how, selection) = match (p, options.tolerance) {
