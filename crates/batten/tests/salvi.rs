@@ -786,11 +786,11 @@ fn registry_and_options() {
             .collect(),
     )
     .expect("closed");
+    assert!(matches!(
+        fair::fair("salvi", &closed, &FairOptions::default()),
+        Err(Error::ClosedUnsupported { .. })
+    ));
     for method in ["salvi", "eck-hadenfeld"] {
-        assert!(matches!(
-            fair::fair(method, &closed, &FairOptions::default()),
-            Err(Error::ClosedUnsupported { .. })
-        ));
         assert!(matches!(
             fair::fair(
                 method,
@@ -905,5 +905,80 @@ proptest! {
         prop_assert!(max_control_move(&faired, &curve) <= delta * (1.0 + 1e-12));
         prop_assert!(max_deviation(&faired, &curve) <= delta * (1.0 + 1e-12));
         prop_assert_eq!(faired.degree(), curve.degree());
+    }
+}
+
+/// A closed curve: an ellipse with a fixed wobble and no symmetry (so that no two control
+/// points are ever equally good to move), listed from point `shift`.
+fn wobbly_ellipse(n: usize, shift: usize) -> Vec<Point> {
+    let pts: Vec<Point> = (0..n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            let r = 2.0 + 0.02 * (((i * 7) % 5) as f64 - 2.0) + 0.01 * (1.7 * i as f64).sin();
+            Point::new(r * a.cos(), 1.3 * r * a.sin())
+        })
+        .collect();
+    (0..n).map(|i| pts[(i + shift) % n]).collect()
+}
+
+#[test]
+fn eck_hadenfeld_fairs_closed_curves_seam_free() {
+    let n = 40;
+    let input = PointSeq::closed(wobbly_ellipse(n, 0)).unwrap();
+    for order in [2, 3] {
+        let opts = FairOptions::default()
+            .with_tolerance(0.1)
+            .with_param("order", order);
+        let out = fair::fair("eck-hadenfeld", &input, &opts).unwrap();
+        let r = &out.report;
+        let p = &r.parameters;
+        let (before, after) = (
+            p["measure_before"].as_f64().unwrap(),
+            p["measure_after"].as_f64().unwrap(),
+        );
+        assert!(after < 0.2 * before, "order {order}: {before} → {after}");
+        assert!(r.max_displacement <= 0.1);
+        // Each move lowers the energy.
+        assert!(r.history.windows(2).all(|w| w[1].measure <= w[0].measure));
+        // The wobble's inflections go (as on an open curve, a δ below the wobble clamps every
+        // move and leaves them).
+        assert!(
+            r.after.inflections * 4 < r.before.inflections,
+            "order {order}: {} → {}",
+            r.before.inflections,
+            r.after.inflections
+        );
+        // Every control point may move, the ones at the seam included.
+        assert!(r.moves.iter().any(|m| m.index == 0 || m.index == n - 1));
+        // The same curve listed from another start gives the same faired curve.
+        for shift in [1, 13, 39] {
+            let rotated = PointSeq::closed(wobbly_ellipse(n, shift)).unwrap();
+            let b = fair::fair("eck-hadenfeld", &rotated, &opts).unwrap();
+            for i in 0..n {
+                let d = b.points[i].distance(out.points[(i + shift) % n]);
+                assert!(d < 1e-9, "order {order}, shift {shift}, point {i}: {d}");
+            }
+        }
+    }
+}
+
+#[test]
+fn eck_hadenfeld_closed_curve_limits() {
+    let few = PointSeq::closed(wobbly_ellipse(7, 0)).unwrap();
+    assert!(matches!(
+        fair::fair("eck-hadenfeld", &few, &FairOptions::default()),
+        Err(Error::TooFewPoints { needed: 8, got: 7 })
+    ));
+    let ok = PointSeq::closed(wobbly_ellipse(8, 0)).unwrap();
+    assert!(fair::fair("eck-hadenfeld", &ok, &FairOptions::default()).is_ok());
+    for (key, value) in [("degree", "2"), ("control_points", "6")] {
+        assert!(matches!(
+            fair::fair(
+                "eck-hadenfeld",
+                &ok,
+                &FairOptions::default().with_param(key, value)
+            ),
+            Err(Error::InvalidParameter { .. })
+        ));
     }
 }

@@ -35,6 +35,14 @@
 //!
 //! Without a tolerance, δ = [`super::local::DEFAULT_TOLERANCE_REL`] × the bounding-box
 //! diagonal of the data; point input is handled as in [`super::salvi`].
+//!
+//! **Closed curves** (point input, at least [`MIN_CLOSED_CONTROL_POINTS`] points) are
+//! interpolated by the periodic cubic of `sapidis-farin` (one control point per point, in its
+//! wrapped form), and the energy is taken over one period with the cyclic Gram matrix
+//! (`Gram::periodic`): every control point is movable and the seam is not special (listing
+//! the points from another start gives the same result, unless two control points tie exactly
+//! as the best move, as on a symmetric curve, where the first in the list wins). Only the
+//! cubic; no B-spline is returned for a closed curve.
 
 use serde_json::Value;
 
@@ -43,7 +51,9 @@ use super::local::{
     movable_mask, resolve_tolerance, select_candidate,
 };
 use super::salvi::insert_common;
+use super::sapidis_farin::{PAD, interpolate_closed};
 use super::{FairMethod, FairOptions, FairStatus, HistoryRow, Move, Outcome, ParamSpec};
+use crate::curve::Curve;
 use crate::error::{Error, Result};
 use crate::geom::{Point, PointSeq, Vec2};
 use crate::numeric::GaussLegendre;
@@ -57,6 +67,10 @@ pub const DEFAULT_MAX_ITERATIONS: usize = 1000;
 
 /// Stop when the best single move would lower the energy by less than this fraction of it.
 pub const DEFAULT_MIN_REL_DECREASE: f64 = 1e-9;
+
+/// Fewest points of a closed curve: the cyclic band of the Gram matrix (half-width 3) must
+/// not wrap onto itself.
+pub const MIN_CLOSED_CONTROL_POINTS: usize = 8;
 
 /// Gauss–Legendre nodes per span for the Gram matrix of a rational curve (its integrand is not
 /// a polynomial).
@@ -166,8 +180,10 @@ impl Default for EckHadenfeldParams {
 pub struct Gram {
     p: usize,
     n: usize,
-    /// `band[a·(p+1) + k] = G[a][a+k]`, k = 0..=p.
+    /// `band[a·(p+1) + k] = G[a][a+k]`, k = 0..=p (indices mod n when `cyclic`).
     band: Vec<f64>,
+    /// The basis of a closed curve: indices are cyclic.
+    cyclic: bool,
 }
 
 impl Gram {
@@ -216,17 +232,94 @@ impl Gram {
                 }
             }
         }
-        Ok(Gram { p, n, band })
+        Ok(Gram {
+            p,
+            n,
+            band,
+            cyclic: false,
+        })
+    }
+
+    /// The Gram matrix of the periodic cubic basis of a closed curve with `n` distinct control
+    /// points `D_d`, given in the wrapped form of [`interpolate_closed`] (`W_r = D_{(r−PAD)
+    /// mod n}`): `G_ab = ∫ R_a^{(l)} R_b^{(l)} dt` over one period, with cyclic indices.
+    ///
+    /// # Errors
+    /// As [`Gram::new`]; [`Error::TooFewPoints`] below [`MIN_CLOSED_CONTROL_POINTS`].
+    pub(crate) fn periodic(wrapped: &BSplineCurve, n: usize, order: usize) -> Result<Gram> {
+        let p = wrapped.degree();
+        if !(1..=3).contains(&order) || order > p {
+            return Err(Error::InvalidParameter {
+                name: "order".into(),
+                reason: format!("must be in 1..=3 and at most the degree {p}, got {order}"),
+            });
+        }
+        if n < MIN_CLOSED_CONTROL_POINTS {
+            return Err(Error::TooFewPoints {
+                needed: MIN_CLOSED_CONTROL_POINTS,
+                got: n,
+            });
+        }
+        let u = wrapped.knots().as_slice();
+        let gl = GaussLegendre::new(p - order + 1);
+        let mut band = vec![0.0; n * (p + 1)];
+        let mut b = [[0.0; MAX_ORDER]; 4];
+        // The spans of one period: span k + PAD covers [τ_k, τ_{k+1}], where the basis
+        // functions W_{k+PAD−p..=k+PAD}, i.e. D_{k+PAD−p−PAD..} (mod n), are non-zero.
+        for k in 0..n {
+            let span = k + PAD;
+            let (a, bnd) = (u[span], u[span + 1]);
+            let half = 0.5 * (bnd - a);
+            let mid = 0.5 * (a + bnd);
+            for (x, w) in gl.nodes().iter().zip(gl.weights()) {
+                wrapped.basis_derivs(span, mid + half * x, order, &mut b);
+                let r = &b[order];
+                let wt = w * half;
+                for c in 0..=p {
+                    let d = (span - p + c + n - PAD % n) % n;
+                    for kk in 0..=p - c {
+                        band[d * (p + 1) + kk] += wt * r[c] * r[c + kk];
+                    }
+                }
+            }
+        }
+        Ok(Gram {
+            p,
+            n,
+            band,
+            cyclic: true,
+        })
     }
 
     /// `G[a][b]` (zero outside the band).
     pub fn get(&self, a: usize, b: usize) -> f64 {
+        if self.cyclic {
+            let k = (b + self.n - a) % self.n;
+            return if k <= self.p {
+                self.band[a * (self.p + 1) + k]
+            } else if self.n - k <= self.p {
+                self.band[b * (self.p + 1) + (self.n - k)]
+            } else {
+                0.0
+            };
+        }
         let (a, b) = if a <= b { (a, b) } else { (b, a) };
         if b - a > self.p || b >= self.n {
             0.0
         } else {
             self.band[a * (self.p + 1) + (b - a)]
         }
+    }
+
+    /// The indices within the bandwidth of `j` (`j` included), cyclic for a closed curve.
+    fn neighbours(&self, j: usize) -> impl Iterator<Item = usize> + use<> {
+        let (p, n, cyclic) = (self.p, self.n, self.cyclic);
+        let (lo, hi) = if cyclic {
+            (j + n - p, j + n + p + 1)
+        } else {
+            (j.saturating_sub(p), (j + p + 1).min(n))
+        };
+        (lo..hi).map(move |i| if cyclic { i % n } else { i })
     }
 
     /// Half-bandwidth p.
@@ -236,12 +329,10 @@ impl Gram {
 
     /// `Σ_{i≠j} G_ji d_i`, the coupling of control point j to the others.
     pub fn coupling(&self, d: &[Point], j: usize) -> Vec2 {
-        let lo = j.saturating_sub(self.p);
-        let hi = (j + self.p + 1).min(self.n);
         let mut s = Vec2::ZERO;
-        for (i, di) in d.iter().enumerate().take(hi).skip(lo) {
+        for i in self.neighbours(j) {
             if i != j {
-                s += di.to_vec2() * self.get(j, i);
+                s += d[i].to_vec2() * self.get(j, i);
             }
         }
         s
@@ -256,9 +347,15 @@ impl Gram {
         for (a, pa) in d.iter().enumerate().take(self.n) {
             let da = pa.to_vec2();
             e += self.get(a, a) * da.length_squared();
-            let hi = (a + self.p + 1).min(self.n);
-            for (b, pb) in d.iter().enumerate().take(hi).skip(a + 1) {
-                e += 2.0 * self.get(a, b) * da.dot(pb.to_vec2());
+            // Each pair once: b = a + 1..=a + p (cyclically, or within the matrix).
+            for k in 1..=self.p {
+                let b = a + k;
+                let b = match (self.cyclic, b < self.n) {
+                    (_, true) => b,
+                    (true, false) => b - self.n,
+                    (false, false) => break,
+                };
+                e += 2.0 * self.get(a, b) * da.dot(d[b].to_vec2());
             }
         }
         e
@@ -329,14 +426,26 @@ pub fn fair_curve(
     }
     let delta = resolve_tolerance(params.tolerance, curve)?;
     let gram = Gram::new(curve, params.order)?;
-    let p = curve.degree();
-    let original: Vec<Point> = curve.control_points().to_vec();
-    let n = original.len();
-    let mut d = original.clone();
+    let original = curve.control_points();
     let movable = movable_mask(
-        n,
+        original.len(),
         local::held_control_points(params.free_ends, params.held_ends),
     );
+    let (d, report) = fair_control_points(original, &gram, &movable, params, delta);
+    Ok((curve.with_control_points(d)?, report))
+}
+
+/// The loop of [`fair_curve`] on control points `original` with the Gram matrix `gram` (linear
+/// or cyclic): the faired control points and the report.
+fn fair_control_points(
+    original: &[Point],
+    gram: &Gram,
+    movable: &[bool],
+    params: &EckHadenfeldParams,
+    delta: f64,
+) -> (Vec<Point>, LocalReport) {
+    let n = original.len();
+    let mut d = original.to_vec();
 
     // The clamped local optimum of j and the energy its move would remove.
     let best_move = |d: &[Point], j: usize| -> (Point, f64, bool) {
@@ -372,7 +481,7 @@ pub fn fair_curve(
             converged = true;
             break;
         }
-        let Some(j) = select_candidate(&gain, &movable, &mut recent) else {
+        let Some(j) = select_candidate(&gain, movable, &mut recent) else {
             converged = true;
             break;
         };
@@ -389,7 +498,7 @@ pub fn fair_curve(
             // The change is negative; `min` guards the running energy against rounding.
             e = (e + change).min(e);
             d[j] = c;
-            for jj in j.saturating_sub(p)..(j + p + 1).min(n) {
+            for jj in gram.neighbours(j) {
                 gain[jj] = if movable[jj] {
                     best_move(&d, jj).1
                 } else {
@@ -413,8 +522,7 @@ pub fn fair_curve(
             max_distance: displacement.max(),
         });
     }
-    let faired = curve.with_control_points(d)?;
-    let measure_after = gram.energy(faired.control_points());
+    let measure_after = gram.energy(&d);
     let status = if moves.is_empty() {
         FairStatus::NoChange
     } else if !converged {
@@ -444,7 +552,7 @@ pub fn fair_curve(
         moves,
         notes,
     };
-    Ok((faired, report))
+    (d, report)
 }
 
 /// The `eck-hadenfeld` method for point input: fit a B-spline, fair it, evaluate it at the
@@ -483,7 +591,7 @@ impl FairMethod for EckHadenfeld {
     }
 
     fn supports_closed(&self) -> bool {
-        false
+        true
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {
@@ -492,6 +600,9 @@ impl FairMethod for EckHadenfeld {
     }
 
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
+        if input.is_closed() {
+            return run_closed(input, options);
+        }
         let fitted = local::fit_input(input, options)?;
         run_fitted(fitted, input, options)
     }
@@ -536,14 +647,31 @@ fn run_fitted(
     };
     let (faired, report) = fair_curve(&fitted.curve, &params)?;
     let points = local::output_points(&faired, &fitted, input, options.fix_ends.is_fixed());
-    let mut parameters = fitted.parameters.clone();
+    Ok(outcome(
+        points,
+        report,
+        &params,
+        fitted.parameters.clone(),
+        fitted.notes,
+        Some(faired),
+    ))
+}
+
+/// The method's [`Outcome`]: the parameters as used and the run's report.
+fn outcome(
+    points: Vec<Point>,
+    report: LocalReport,
+    params: &EckHadenfeldParams,
+    mut parameters: serde_json::Map<String, Value>,
+    mut notes: Vec<String>,
+    curve: Option<BSplineCurve>,
+) -> Outcome {
     parameters.insert("order".into(), Value::from(params.order));
     parameters.insert("tabu".into(), params.tabu_length.into());
     parameters.insert("max_iterations".into(), params.max_iterations.into());
     insert_common(&mut parameters, &report);
-    let mut notes = fitted.notes;
     notes.extend(report.notes);
-    Ok(Outcome {
+    Outcome {
         points,
         status: report.status,
         iterations: report.iterations,
@@ -551,9 +679,95 @@ fn run_fitted(
         history: report.history,
         parameters,
         notes,
-        curve: Some(faired),
+        curve,
         tangents: None,
-    })
+    }
+}
+
+/// The method on a closed curve: the periodic cubic through the points (the wrapped form
+/// of [`interpolate_closed`]), its `n` distinct control points faired with the cyclic Gram
+/// matrix, every one of them movable; the output points are the faired curve at the data
+/// parameters. Only the cubic: a closed curve with another `degree` is refused.
+fn run_closed(input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
+    let (order, tabu_length) = order_and_tabu(options)?;
+    let degree = local::fit_degree(options)?;
+    if degree != 3 {
+        return Err(Error::InvalidParameter {
+            name: "degree".into(),
+            reason: format!("a closed curve is faired as the periodic cubic, not degree {degree}"),
+        });
+    }
+    if options.params.contains_key("control_points") {
+        return Err(Error::InvalidParameter {
+            name: "control_points".into(),
+            reason: "a closed curve is interpolated (one control point per point)".into(),
+        });
+    }
+    let points = input.points();
+    let n = points.len();
+    if n < MIN_CLOSED_CONTROL_POINTS {
+        return Err(Error::TooFewPoints {
+            needed: MIN_CLOSED_CONTROL_POINTS,
+            got: n,
+        });
+    }
+    let (wrapped, t) = interpolate_closed(points)?;
+    let gram = Gram::periodic(&wrapped, n, order)?;
+    let original: Vec<Point> = wrapped.control_points()[PAD..PAD + n].to_vec();
+    let residual = points
+        .iter()
+        .zip(&t)
+        .map(|(q, &tk)| q.distance(wrapped.eval(tk)))
+        .fold(0.0, f64::max);
+    let mut notes = Vec::new();
+    let delta = match options.tolerance {
+        // The faired curve is within δ of the interpolant, which is within `residual` of the
+        // points (rounding).
+        Some(tol) => {
+            let margin = local::ROUNDING_MARGIN_ULPS
+                * f64::EPSILON
+                * crate::geom::max_abs_coordinate(points);
+            let d = tol - residual - margin;
+            if d > 0.0 {
+                d
+            } else {
+                notes.push(format!(
+                    "the periodic interpolant deviates {residual:.6e} from the points, which is \
+                     not below the tolerance {tol:.6e}; fairing within δ = tolerance"
+                ));
+                tol
+            }
+        }
+        None => {
+            let d = local::DEFAULT_TOLERANCE_REL * input.scale();
+            notes.push(format!(
+                "no tolerance given: δ = {} × bounding-box diagonal = {d:.6e}",
+                local::DEFAULT_TOLERANCE_REL
+            ));
+            d
+        }
+    };
+    let params = EckHadenfeldParams {
+        order,
+        tolerance: Some(delta),
+        tabu_length,
+        max_iterations: options.iterations_or(DEFAULT_MAX_ITERATIONS),
+        min_rel_decrease: DEFAULT_MIN_REL_DECREASE,
+        free_ends: true,
+        held_ends: 0,
+    };
+    let (d, report) = fair_control_points(&original, &gram, &vec![true; n], &params, delta);
+    let ctrl: Vec<Point> = (0..n + PAD).map(|r| d[(r + n - PAD % n) % n]).collect();
+    let faired = wrapped.with_control_points(ctrl)?;
+    let out: Vec<Point> = t.iter().map(|&tk| faired.eval(tk)).collect();
+    let mut parameters = serde_json::Map::new();
+    parameters.insert("fit".into(), "periodic cubic interpolation".into());
+    parameters.insert("degree".into(), 3.into());
+    parameters.insert("control_points".into(), n.into());
+    parameters.insert("fit_residual".into(), local::json_f64(residual));
+    parameters.insert("delta".into(), local::json_f64(delta));
+    // The wrapped form is not a clamped curve of its own: no curve is returned.
+    Ok(outcome(out, report, &params, parameters, notes, None))
 }
 
 #[cfg(test)]
@@ -561,6 +775,43 @@ mod tests {
     use super::*;
     use crate::curve::CurveDeriv;
     use crate::spline::KnotVector;
+
+    #[test]
+    fn periodic_gram_is_the_energy_over_one_period() {
+        let n = 13;
+        let pts: Vec<Point> = (0..n)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / n as f64 + 0.07 * (i % 4) as f64;
+                Point::new(2.0 * a.cos() + 0.05 * (3.0 * a).sin(), a.sin())
+            })
+            .collect();
+        let (wrapped, _) = interpolate_closed(&pts).unwrap();
+        let u = wrapped.knots().as_slice().to_vec();
+        let d: Vec<Point> = wrapped.control_points()[PAD..PAD + n].to_vec();
+        let gl = GaussLegendre::new(8);
+        for order in [2, 3] {
+            let gram = Gram::periodic(&wrapped, n, order).unwrap();
+            // Direct quadrature of |x^(l)|² over the spans of one period.
+            let mut direct = 0.0;
+            for k in 0..n {
+                let (a, b) = (u[k + PAD], u[k + PAD + 1]);
+                direct += gl.integrate(a, b, |t| {
+                    let dv = wrapped.derivatives(a.max(t.min(b)));
+                    let v = if order == 2 { dv.d2 } else { dv.d3 };
+                    v.length_squared()
+                });
+            }
+            let e = gram.energy(&d);
+            assert!(
+                (e - direct).abs() <= 1e-9 * direct,
+                "order {order}: {e} vs {direct}"
+            );
+            // Symmetric, and cyclic: entries across the seam are there.
+            assert_eq!(gram.get(0, n - 1), gram.get(n - 1, 0));
+            assert!(gram.get(0, n - 1) != 0.0);
+            assert_eq!(gram.get(0, 4), 0.0);
+        }
+    }
 
     fn curve(weights: Option<Vec<f64>>) -> BSplineCurve {
         let pts = vec![

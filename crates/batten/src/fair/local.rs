@@ -448,7 +448,7 @@ pub(crate) fn check_fit_params(options: &FairOptions) -> Result<()> {
 }
 
 /// The `degree` of the B-spline fitted to point input, 2..=5.
-fn fit_degree(options: &FairOptions) -> Result<usize> {
+pub(crate) fn fit_degree(options: &FairOptions) -> Result<usize> {
     options.param_usize_in("degree", DEFAULT_FIT_DEGREE, 2, 5)
 }
 

@@ -374,7 +374,7 @@ impl LocalProblem for KnotState {
 /// Padding of the wrapped form of a periodic cubic: period knot `τ_m` is knot index
 /// `m + PAD`, so that every period knot is a simple interior knot with the whole Farin
 /// stencil (control points `j−4..=j`, knots `j−3..=j+3`) inside the wrapped curve.
-const PAD: usize = 4;
+pub(crate) const PAD: usize = 4;
 
 /// The periodic (closed) cubic B-spline through `points` with chord-length parameters and
 /// knots at the data parameters, in a wrapped form: a [`BSplineCurve`] with `N + 4` control
@@ -386,7 +386,7 @@ const PAD: usize = 4;
 /// # Errors
 /// [`Error::TooFewPoints`] below [`MIN_CLOSED_POINTS`]; duplicate or non-finite points; a
 /// singular interpolation system.
-fn interpolate_closed(points: &[Point]) -> Result<(BSplineCurve, Vec<f64>)> {
+pub(crate) fn interpolate_closed(points: &[Point]) -> Result<(BSplineCurve, Vec<f64>)> {
     let n = points.len();
     if n < MIN_CLOSED_POINTS {
         return Err(Error::TooFewPoints {
