@@ -71,6 +71,9 @@
 //!   parameters) stay within the tolerance. `--fix-ends` changes nothing about the curve: the
 //!   end control points are fixed by default already (and an interpolating clamped fit
 //!   passes through the end points); it makes the output's end points the input's exactly.
+//!   `--fix-ends=tangent` (`curvature`) also holds the second (and third) control point at
+//!   each end ([`SalviParams::held_ends`]), which keeps the curve's end tangents (and
+//!   curvatures).
 //!
 //! [`DEFAULT_TOLERANCE_REL`]: super::local::DEFAULT_TOLERANCE_REL
 
