@@ -51,7 +51,7 @@ use super::local::{
     movable_mask, resolve_tolerance, select_candidate,
 };
 use super::salvi::insert_common;
-use super::sapidis_farin::{PAD, interpolate_closed};
+use super::sapidis_farin::{PAD, interpolate_closed, period_index};
 use super::{FairMethod, FairOptions, FairStatus, HistoryRow, Move, Outcome, ParamSpec};
 use crate::curve::Curve;
 use crate::error::{Error, Result};
@@ -194,12 +194,7 @@ impl Gram {
     /// energy would vanish identically).
     pub fn new(curve: &BSplineCurve, order: usize) -> Result<Gram> {
         let p = curve.degree();
-        if !(1..=3).contains(&order) || order > p {
-            return Err(Error::InvalidParameter {
-                name: "order".into(),
-                reason: format!("must be in 1..=3 and at most the degree {p}, got {order}"),
-            });
-        }
+        check_order(order, p)?;
         let n = curve.control_points().len();
         let u = curve.knots().as_slice();
         let weights = curve.weights();
@@ -224,12 +219,7 @@ impl Gram {
                     None => r[..=p].copy_from_slice(&b[order][..=p]),
                     Some(ws) => rational_derivative(&b, &ws[span - p..=span], order, &mut r),
                 }
-                let wt = w * half;
-                for c in 0..=p {
-                    for k in 0..=p - c {
-                        band[(span - p + c) * (p + 1) + k] += wt * r[c] * r[c + k];
-                    }
-                }
+                add_products(&mut band, p, w * half, &r, |c| span - p + c);
             }
         }
         Ok(Gram {
@@ -248,12 +238,7 @@ impl Gram {
     /// As [`Gram::new`]; [`Error::TooFewPoints`] below [`MIN_CLOSED_CONTROL_POINTS`].
     pub(crate) fn periodic(wrapped: &BSplineCurve, n: usize, order: usize) -> Result<Gram> {
         let p = wrapped.degree();
-        if !(1..=3).contains(&order) || order > p {
-            return Err(Error::InvalidParameter {
-                name: "order".into(),
-                reason: format!("must be in 1..=3 and at most the degree {p}, got {order}"),
-            });
-        }
+        check_order(order, p)?;
         if n < MIN_CLOSED_CONTROL_POINTS {
             return Err(Error::TooFewPoints {
                 needed: MIN_CLOSED_CONTROL_POINTS,
@@ -273,14 +258,9 @@ impl Gram {
             let mid = 0.5 * (a + bnd);
             for (x, w) in gl.nodes().iter().zip(gl.weights()) {
                 wrapped.basis_derivs(span, mid + half * x, order, &mut b);
-                let r = &b[order];
-                let wt = w * half;
-                for c in 0..=p {
-                    let d = (span - p + c + n - PAD % n) % n;
-                    for kk in 0..=p - c {
-                        band[d * (p + 1) + kk] += wt * r[c] * r[c + kk];
-                    }
-                }
+                add_products(&mut band, p, w * half, &b[order], |c| {
+                    period_index(span - p + c, n)
+                });
             }
         }
         Ok(Gram {
@@ -359,6 +339,28 @@ impl Gram {
             }
         }
         e
+    }
+}
+
+/// An energy order in `1..=3` and at most the degree `p` (else the energy vanishes).
+fn check_order(order: usize, p: usize) -> Result<()> {
+    if !(1..=3).contains(&order) || order > p {
+        return Err(Error::InvalidParameter {
+            name: "order".into(),
+            reason: format!("must be in 1..=3 and at most the degree {p}, got {order}"),
+        });
+    }
+    Ok(())
+}
+
+/// Add `wt · r_c · r_{c+k}` to `G[row(c)][row(c) + k]` for the `p + 1` basis values `r` of one
+/// quadrature node (`row(c)` is the matrix index of the span's basis function c).
+fn add_products(band: &mut [f64], p: usize, wt: f64, r: &[f64], row: impl Fn(usize) -> usize) {
+    for c in 0..=p {
+        let a = row(c);
+        for k in 0..=p - c {
+            band[a * (p + 1) + k] += wt * r[c] * r[c + k];
+        }
     }
 }
 
@@ -757,7 +759,7 @@ fn run_closed(input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
         held_ends: 0,
     };
     let (d, report) = fair_control_points(&original, &gram, &vec![true; n], &params, delta);
-    let ctrl: Vec<Point> = (0..n + PAD).map(|r| d[(r + n - PAD % n) % n]).collect();
+    let ctrl: Vec<Point> = (0..n + PAD).map(|r| d[period_index(r, n)]).collect();
     let faired = wrapped.with_control_points(ctrl)?;
     let out: Vec<Point> = t.iter().map(|&tk| faired.eval(tk)).collect();
     let mut parameters = serde_json::Map::new();

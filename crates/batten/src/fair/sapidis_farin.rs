@@ -218,7 +218,7 @@ impl KnotState {
     /// The knot index that stands for knot `x` among the candidates.
     fn candidate_knot(&self, x: usize) -> usize {
         match self.period {
-            Some(n) => PAD + (x + n - PAD % n) % n,
+            Some(n) => PAD + period_index(x, n),
             None => x,
         }
     }
@@ -362,7 +362,7 @@ impl LocalProblem for KnotState {
             self.disp.set(k, self.e[k].length());
         }
         // On a closed curve, the index of the distinct control point.
-        let index = self.period.map_or(c, |n| (c + n - PAD % n) % n);
+        let index = self.period.map_or(c, |n| period_index(c, n));
         Ok((index, step.length()))
     }
 
@@ -375,6 +375,12 @@ impl LocalProblem for KnotState {
 /// `m + PAD`, so that every period knot is a simple interior knot with the whole Farin
 /// stencil (control points `j−4..=j`, knots `j−3..=j+3`) inside the wrapped curve.
 pub(crate) const PAD: usize = 4;
+
+/// What wrapped index `r` (of a control point or a knot) stands for in one period: `D_d` or
+/// `τ_d` with `d = (r − PAD) mod n`.
+pub(crate) fn period_index(r: usize, n: usize) -> usize {
+    (r + n - PAD % n) % n
+}
 
 /// The periodic (closed) cubic B-spline through `points` with chord-length parameters and
 /// knots at the data parameters, in a wrapped form: a [`BSplineCurve`] with `N + 4` control
