@@ -72,15 +72,45 @@ pub fn parse_end_fix(s: &str) -> Result<EndFix, String> {
         .map_err(|_| format!("'{s}' is not one of position, tangent, curvature (or free)"))
 }
 
+/// The value of `--tolerance`: a distance in data units, or `auto` (`k·σ̂` from the data).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Tolerance {
+    /// A distance in data units.
+    Given(f64),
+    /// `k·σ̂`, from the noise estimate of the input.
+    Auto,
+}
+
+/// `--tolerance D|auto` (clap value parser). Negative and non-finite values are refused
+/// here, with the flag named.
+///
+/// # Errors
+/// A message naming what the flag accepts.
+pub fn parse_tolerance(s: &str) -> Result<Tolerance, String> {
+    if s.trim() == "auto" {
+        return Ok(Tolerance::Auto);
+    }
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(Tolerance::Given(v)),
+        _ => Err(format!(
+            "'{s}' is not a positive distance in data units or 'auto'"
+        )),
+    }
+}
+
 /// Options from the common flags.
 pub fn options(
-    tolerance: Option<f64>,
+    tolerance: Option<Tolerance>,
     fix_ends: EndFix,
     max_iterations: Option<usize>,
     params: BTreeMap<String, String>,
 ) -> FairOptions {
     let mut o = FairOptions::default().with_end_fix(fix_ends);
-    o.tolerance = tolerance;
+    match tolerance {
+        Some(Tolerance::Given(d)) => o.tolerance = Some(d),
+        Some(Tolerance::Auto) => o = o.with_auto_tolerance(),
+        None => {}
+    }
     o.max_iterations = max_iterations;
     o.params = params;
     o

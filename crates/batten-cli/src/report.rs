@@ -41,9 +41,10 @@ pub struct ReportArgs {
     /// max displacement of the first method listed unless it is first itself
     #[arg(long, value_delimiter = ',', value_name = "A,B,...")]
     methods: Vec<String>,
-    /// Largest distance any point may move, in data units
-    #[arg(long, value_name = "D")]
-    tolerance: Option<f64>,
+    /// Largest distance any point may move, in data units, or `auto`: three times the noise
+    /// estimate σ̂ of the input (`band`'s default)
+    #[arg(long, value_name = "D|auto", allow_hyphen_values = true, value_parser = input::parse_tolerance)]
+    tolerance: Option<input::Tolerance>,
     /// Keep the ends of an open curve: the end points (bare `--fix-ends`, or `=position`),
     /// also the end tangents (`=tangent`) or also the end curvatures (`=curvature`)
     #[arg(long, value_name = "WHAT", num_args = 0..=1, require_equals = true,

@@ -8,6 +8,7 @@ mod arclength;
 mod curvature;
 mod gfi;
 mod metrics;
+mod noise;
 
 pub use arclength::{ArcLengthTable, arc_length};
 pub use curvature::{
@@ -18,3 +19,4 @@ pub use gfi::{FairnessIndicators, fairness_indicators};
 pub use metrics::{
     Displacement, FairnessMetrics, ZERO_REL, analysis_curve, count_sign_changes, displacement, sgn0,
 };
+pub use noise::{MAD_TO_SIGMA, noise_sigma};

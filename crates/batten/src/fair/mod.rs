@@ -30,13 +30,13 @@ pub use han::Han;
 pub use kjellander::{
     Energy, HermiteMove, Kjellander, KpRule, Poliakoff, fair_hermite, hermite_step,
 };
-pub use options::{EndFix, FairOptions, ParamSpec};
-pub use report::{EndChanges, FairReport, FairStatus, HistoryRow, Move};
+pub use options::{AUTO_TOLERANCE_K, EndFix, FairOptions, ParamSpec};
+pub use report::{EndChanges, FairReport, FairStatus, HistoryRow, Move, ToleranceSource};
 pub use salvi::Salvi;
 pub use sapidis_farin::{SapidisFarin, remove_reinsert_knot};
 pub use smoothing::{Mst, Smoothing, SmoothingInfo, SmoothingSpline, SmoothingTrial};
 
-use crate::analysis::{FairnessMetrics, displacement};
+use crate::analysis::{FairnessMetrics, displacement, noise_sigma};
 use crate::error::{Error, Result};
 use crate::geom::{Point, PointSeq, Vec2};
 use crate::spline::BSplineCurve;
@@ -104,6 +104,23 @@ pub trait FairMethod: Sync {
     /// Whether [`FairMethod::run_curve`] is implemented (B-spline input accepted).
     fn run_curve_supported(&self) -> bool {
         false
+    }
+
+    /// Whether the method takes an automatic tolerance `k·σ̂` when none is given, as if
+    /// [`FairOptions::auto_tolerance`] were set. `false` (the default): no tolerance means
+    /// no bound.
+    fn auto_tolerance_by_default(&self) -> bool {
+        false
+    }
+
+    /// The factor `k` of an automatic tolerance `k·σ̂` for these options:
+    /// [`AUTO_TOLERANCE_K`] unless the method has a parameter for it.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a bad value of that parameter.
+    fn auto_tolerance_factor(&self, options: &FairOptions) -> Result<f64> {
+        let _ = options;
+        Ok(AUTO_TOLERANCE_K)
     }
 }
 
@@ -229,6 +246,9 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
     check_options(m, input.is_closed(), options)?;
     let before = FairnessMetrics::of_seq(input)?;
     let start = Instant::now();
+    let sigma = noise_sigma(input.points(), input.is_closed());
+    let (resolved, source) = resolve_tolerance(m, options, sigma, input.bbox().diagonal())?;
+    let options = &resolved;
     let held = options.fix_ends.held();
     let outcome = if !input.is_closed() && 2 * held >= input.len() {
         // Every point is held: nothing may move.
@@ -245,7 +265,43 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
     } else {
         m.run(input, options)?
     };
-    finish(m, input, before, options, outcome, start)
+    finish(
+        m,
+        input,
+        before,
+        options,
+        outcome,
+        start,
+        (source, Some(sigma)),
+    )
+}
+
+/// The smallest automatic tolerance, relative to the bounding-box diagonal: below it the
+/// noise estimate is rounding noise, and `k·σ̂` is raised to it so that the tolerance stays
+/// a positive number a method can scale by.
+const AUTO_TOLERANCE_FLOOR_REL: f64 = 1e-12;
+
+/// The options with the tolerance the run uses, and where it came from: the given one, or
+/// `k·σ̂` when [`FairOptions::auto_tolerance`] is set (or the method defaults to it) and no
+/// tolerance was given.
+fn resolve_tolerance(
+    m: &dyn FairMethod,
+    options: &FairOptions,
+    sigma: f64,
+    diagonal: f64,
+) -> Result<(FairOptions, Option<ToleranceSource>)> {
+    let mut resolved = options.clone();
+    if options.tolerance.is_some() {
+        return Ok((resolved, Some(ToleranceSource::Given)));
+    }
+    if !(options.auto_tolerance || m.auto_tolerance_by_default()) {
+        return Ok((resolved, None));
+    }
+    let k = m.auto_tolerance_factor(options)?;
+    let floor = AUTO_TOLERANCE_FLOOR_REL * diagonal.max(f64::MIN_POSITIVE);
+    resolved.tolerance = Some((k * sigma).max(floor));
+    resolved.auto_tolerance = false;
+    Ok((resolved, Some(ToleranceSource::Auto)))
 }
 
 /// The change of the discrete end tangents and curvatures from `input` to `output` (open
@@ -285,6 +341,15 @@ fn end_changes(input: &PointSeq, output: &PointSeq) -> Option<EndChanges> {
 pub fn fair_curve(name: &str, curve: &BSplineCurve, options: &FairOptions) -> Result<Faired> {
     let m = method(name)?;
     check_options(m, false, options)?;
+    if options.tolerance.is_none() && options.auto_tolerance {
+        return Err(Error::InvalidParameter {
+            name: "tolerance".into(),
+            reason:
+                "auto takes its noise estimate from points; give a tolerance for a B-spline curve"
+                    .into(),
+        });
+    }
+    let source = options.tolerance.map(|_| ToleranceSource::Given);
     let start = Instant::now();
     let Some(run) = m.run_curve(curve, options) else {
         let takes: Vec<&str> = REGISTRY
@@ -303,7 +368,7 @@ pub fn fair_curve(name: &str, curve: &BSplineCurve, options: &FairOptions) -> Re
     };
     let (input, outcome) = run?;
     let before = FairnessMetrics::of_seq(&input)?;
-    finish(m, &input, before, options, outcome, start)
+    finish(m, &input, before, options, outcome, start, (source, None))
 }
 
 /// The common part of every report: displacements, metrics after, the tolerance verdict.
@@ -314,6 +379,7 @@ fn finish(
     options: &FairOptions,
     outcome: Outcome,
     start: Instant,
+    (tolerance_source, noise_sigma): (Option<ToleranceSource>, Option<f64>),
 ) -> Result<Faired> {
     let elapsed = start.elapsed();
     if outcome.points.len() != input.len() {
@@ -351,6 +417,8 @@ fn finish(
         max_displacement_index: disp.argmax,
         sum_displacement: disp.sum,
         tolerance: options.tolerance,
+        tolerance_source,
+        noise_sigma,
         tolerance_met,
         fix_ends: options.fix_ends.is_fixed(),
         fixed_ends: options.fix_ends,

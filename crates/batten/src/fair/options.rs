@@ -85,6 +85,11 @@ impl FromStr for EndFix {
     }
 }
 
+/// The factor `k` of an automatic tolerance `k·σ̂` ([`FairOptions::auto_tolerance`]): three
+/// noise standard deviations, which a Gaussian sample exceeds with probability 0.3 % per
+/// coordinate.
+pub const AUTO_TOLERANCE_K: f64 = 3.0;
+
 /// Options common to every fairing method, plus the method's own parameters.
 ///
 /// Built with [`FairOptions::default`] and the `with_*` methods; the defaults are in
@@ -97,6 +102,13 @@ pub struct FairOptions {
     ///
     /// Default value: `None`.
     pub tolerance: Option<f64>,
+    /// Take the tolerance from the data when [`FairOptions::tolerance`] is `None`:
+    /// `k·σ̂`, with `σ̂` the noise estimate [`crate::analysis::noise_sigma`] and `k` the
+    /// method's factor ([`AUTO_TOLERANCE_K`] unless the method has its own, `band`'s `k`).
+    /// Methods that default to it (`band`) take it whenever no tolerance is given.
+    ///
+    /// Default value: `false`.
+    pub auto_tolerance: bool,
     /// What to keep at the ends of an open curve ([`EndFix`]).
     ///
     /// Default value: [`EndFix::Free`].
@@ -118,6 +130,7 @@ impl FairOptions {
     /// parameters.
     pub const DEFAULT: FairOptions = FairOptions {
         tolerance: None,
+        auto_tolerance: false,
         fix_ends: EndFix::Free,
         max_iterations: None,
         params: BTreeMap::new(),
@@ -126,6 +139,14 @@ impl FairOptions {
     /// Set the tolerance (largest allowed point displacement, data units).
     pub fn with_tolerance(mut self, tolerance: f64) -> FairOptions {
         self.tolerance = Some(tolerance);
+        self
+    }
+
+    /// Take the tolerance from the data (`--tolerance auto`): `k·σ̂`, see
+    /// [`FairOptions::auto_tolerance`]. Clears a given tolerance.
+    pub fn with_auto_tolerance(mut self) -> FairOptions {
+        self.tolerance = None;
+        self.auto_tolerance = true;
         self
     }
 

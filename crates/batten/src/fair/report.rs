@@ -22,6 +22,17 @@ pub enum FairStatus {
     NoChange,
 }
 
+/// Where a run's tolerance came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum ToleranceSource {
+    /// Given by the caller (`--tolerance D`).
+    Given,
+    /// Computed from the data as `k·σ̂` (`--tolerance auto`, or `band` without a tolerance).
+    Auto,
+}
+
 /// One point move of a local method.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Move {
@@ -82,8 +93,13 @@ pub struct FairReport {
     pub max_displacement_index: usize,
     /// Sum of point displacements (HAN's S_d).
     pub sum_displacement: f64,
-    /// The tolerance asked for, if any.
+    /// The tolerance used, if any: the one given, or the automatic `k·σ̂`.
     pub tolerance: Option<f64>,
+    /// Where the tolerance came from: `given`, `auto` (`k·σ̂`), or `null` when there is none.
+    pub tolerance_source: Option<ToleranceSource>,
+    /// The noise estimate σ̂ of the input points, in data units
+    /// ([`crate::analysis::noise_sigma`]; `null` for B-spline input).
+    pub noise_sigma: Option<f64>,
     /// True when no point moved farther than the tolerance (always true without one).
     pub tolerance_met: bool,
     /// Whether the end points were fixed.
