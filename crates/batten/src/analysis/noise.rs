@@ -68,7 +68,11 @@ pub fn noise_sigma(pts: &[Point], closed: bool) -> f64 {
     );
     let reach = if spacing > 0.0 {
         let m = (NORMAL_CHORD_NOISE_SPANS * rough / spacing).ceil();
-        if m.is_finite() { (m as usize).min(n / 8) } else { 0 }
+        if m.is_finite() {
+            (m as usize).min(n / 8)
+        } else {
+            0
+        }
     } else {
         0
     };
