@@ -1,17 +1,22 @@
 #!/usr/bin/env python3
 """Quality benchmark of batten's fairing methods against the peers users would pick (issue #18).
 
-    pip install numpy scipy csaps cadquery-ocp-novtk      # cadquery-ocp works too; OCCT is optional
+    python3 -m venv /tmp/benv && /tmp/benv/bin/pip install numpy scipy csaps cadquery-ocp-novtk
     cargo build --release -p batten-cli
-    python3 bench/quality.py [--split test|tune] [--quick] [--methods han,mst,...]
-                             [--peers csaps,gcv,splprep,occt|none] [--tol-mode auto|true3]
-                             [--limit METHOD=NMAX,...] [--timeout 60] [--jobs 2]
-                             [--out bench/results-quality.md] [--csv FILE] [--no-clean]
+    /tmp/benv/bin/python bench/quality.py [--quick] [--methods han,mst,band,...] [--auto]
+        [--peers csaps,gcv,splprep,occt|none] [--tol-mode hat3|auto|true3] [--split test|tune]
+        [--families sine,...] [--sizes 30,100] [--limit TOOL=NMAX,...] [--timeout 60] [--jobs 2]
+        [--out bench/results-quality.md] [--csv FILE] [--json FILE] [--no-clean]
+
+(`cadquery-ocp` instead of `cadquery-ocp-novtk` works too, with VTK; without either, occt is
+left out and said so.) The Markdown goes to stdout and to `--out`; `--json FILE` writes the
+totals, the per-family/n/noise breakdowns, the clean-input summary and every row as JSON.
 
 The batten binary is `$BATTEN_BIN`, by default `target/release/batten` of the repository this
 script lives in. `--methods` defaults to every method `$BATTEN_BIN methods` lists, so a binary
-with a new method is measured without changing this script. A method spec may carry options,
-`han[passes=2;max_iterations=5]` (see `compare_peers.py`).
+with a new method is measured without changing this script; a method the binary does not know
+is warned about and each of its runs reported as failed (with batten's message), not fatal. A
+method spec may carry options, `han[passes=2;max_iterations=5]` (see `compare_peers.py`).
 
 Protocol
 ========
@@ -33,11 +38,13 @@ Noise. n ∈ {30, 100, 300, 1000}; Gaussian noise, isotropic, independent per co
 one seed. Full run: 10 × 4 × 3 × 3 = 360 noisy curves.
 
 Methods. Every batten method: `$BATTEN_BIN fair IN.csv -o OUT.csv --method M --tolerance T
---report R.json`, T = `auto` (3·σ̂, batten's noise estimate; `--tol-mode auto`, default) or
+--report R.json`, T = 3·σ̂ as a number (`--tol-mode hat3`, the default: works with any binary),
+the word `auto` (`--auto` or `--tol-mode auto`: batten estimates σ̂ itself and takes k·σ̂, k = 3
+unless the method has its own, as `band` does; `band` without `--tolerance` does the same), or
 3·σ with the true σ (`--tol-mode true3`). batten runs with RAYON_NUM_THREADS=1 (the script runs
 `--jobs` curves at once). Exit code 1 (tolerance missed) still yields a measured result; no
-output file, a crash or the timeout (`--timeout`, 60 s) counts as a failure. `--limit M=N`
-skips method M on curves of more than N points (recorded as `skipped`).
+output file, a crash or the timeout (`--timeout`, 60 s) counts as a failure. `--limit T=N`
+skips tool T (a method or a peer) on curves of more than N points (recorded as `skipped`).
 
 Peers (each result is a set of output points, one per input point):
   - `csaps@M`: PyPI csaps `CubicSmoothingSpline` on chord-length parameters, evaluated there,
@@ -52,7 +59,8 @@ Peers (each result is a set of output points, one per input point):
     point i is the projection of input point i on the curve (nearest point, searched near the
     chord-length parameter and refined by Newton's method). Skipped when OCP is not installed.
 σ̂ is batten's noise estimate (`analysis/noise.rs`, ported here as `noise_sigma` and checked
-against the `noise_sigma` in batten's reports); with `--tol-mode true3` the true σ.
+against the `noise_sigma` in batten's reports: the Markdown gives the largest difference);
+with `--tol-mode true3` the true σ.
 
 Metrics, the same for every result, on the C² cubic spline with chord-length parameters and
 not-a-knot ends through the output points (batten's analysis curve):
@@ -73,7 +81,8 @@ not-a-knot ends through the output points (batten's analysis curve):
 Clean input (`--no-clean` to skip): exact samples of a circle (closed), a circle arc, a
 clothoid, a logarithmic spiral and every `examples/data/*-truth.*` file (their analytic forms,
 from examples/data/README.md, give the exact curvature; the files are checked against them).
-Each method runs with `--tolerance auto` and with a fixed tolerance of 0.5 % of the diagonal;
+Each method runs with 3σ̂ (`auto` with `--auto`; floored at 1e-12 of the diagonal as batten
+floors `auto`, the samples being exact) and with a fixed tolerance of 0.5 % of the diagonal;
 gcv, splprep and occt run too (σ̂ from the points). A violation: more inflections or more
 vibrations than the input (`analyze --json` before and after), or a relative curvature error
 more than 1 % above the input's own (the spline through the exact samples against the exact κ).
@@ -99,6 +108,7 @@ import subprocess  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
+import warnings  # noqa: E402
 from collections import defaultdict  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -136,9 +146,13 @@ MATCH_FRACTION = 0.03  # inflection matching window, fraction of the curve lengt
 MATCH_SPACINGS = 2.0  # ... and at least this many mean point spacings
 CLEAN_FIXED_TOL = 0.005  # the fixed clean-input tolerance, fraction of the diagonal
 CLEAN_KAPPA_SLACK = 0.01  # relative increase of the curvature error that counts as a violation
-CSAPS_BISECTIONS = 32  # on logit p in [−40, 40]: p to 2e-8 in logit, far below what max displacement sees
+CSAPS_BISECTIONS = 24  # on logit p in [−40, 40]: to 5e-6 in logit, far below what max displacement sees
+TOL_FACTOR = 3.0  # the tolerance is this many noise standard deviations (batten's `auto`: k = 3)
+AUTO_TOLERANCE_FLOOR_REL = 1e-12  # batten's floor of `auto`, fraction of the diagonal (no zero tolerance)
 OCCT_WEIGHTS = (0.4, 0.2, 0.4)
 OCCT_DEGMAX = 8
+MAD_TO_SIGMA = 1.4826  # the MAD-to-σ factor for Gaussian noise
+NORMAL_CHORD_NOISE_SPANS = 20.0  # batten's: the normal's chord spans about this many rough noise scales
 OCCT_TIE_GAP = 1e-9  # parameters closer than this fraction of the range count as one (spread_ties)
 
 
@@ -453,20 +467,34 @@ def match(result_pos, true_pos, window):
 
 
 def noise_sigma(p, closed=False):
-    """batten's noise estimate σ̂ (`analysis/noise.rs`): 1.4826·median|n·Δ³p|/√20 with n the
-    normal of the chord p[i+3] − p[i]."""
-    q = np.vstack([p, p[:3]]) if closed else p
-    if len(p) < 4:
+    """batten's noise estimate σ̂ (`analysis/noise.rs`): 1.4826·median|n·Δ³p|/√20, n the normal
+    of the chord p[i+3+m] − p[i−m] (indices clamped on an open curve, wrapped on a closed one);
+    m = 0 unless the noise is comparable to the spacing: m = ⌈20·rough/spacing⌉ ≤ n/8, rough the
+    same MAD over the whole |Δ³p|, spacing the median distance of neighbours."""
+    n = len(p)
+    if n < 4:
         return 0.0
-    d3 = q[3:] - 3 * q[2:-1] + 3 * q[1:-2] - q[:-3]
-    ch = q[3:] - q[:-3]
+    count = n if closed else n - 3
+    idx = lambda i: np.mod(i, n) if closed else np.clip(i, 0, n - 1)  # noqa: E731
+    i = np.arange(count)
+    d3 = p[idx(i + 3)] - 3 * p[idx(i + 2)] + 3 * p[idx(i + 1)] - p[idx(i)]
+    rough = _upper_median(np.hypot(d3[:, 0], d3[:, 1])) * MAD_TO_SIGMA / math.sqrt(20.0)
+    j = np.arange(n if closed else n - 1)
+    spacing = _upper_median(np.hypot(*(p[idx(j + 1)] - p[idx(j)]).T))
+    reach = 0
+    if spacing > 0:
+        m = math.ceil(NORMAL_CHORD_NOISE_SPANS * rough / spacing)
+        reach = min(int(m), n // 8) if math.isfinite(m) else 0
+    ch = p[idx(i + 3 + reach)] - p[idx(i - reach)]
     ln = np.hypot(ch[:, 0], ch[:, 1])
     ok = ln > 0
-    if not ok.any():
-        return 0.0
-    v = np.abs(-ch[ok, 1] * d3[ok, 0] + ch[ok, 0] * d3[ok, 1]) / ln[ok]
-    v.sort()
-    return float(1.4826 * v[len(v) // 2] / math.sqrt(20.0))
+    v = np.abs(d3[ok, 0] * ch[ok, 1] - d3[ok, 1] * ch[ok, 0]) / ln[ok]
+    return float(MAD_TO_SIGMA * _upper_median(v) / math.sqrt(20.0))
+
+
+def _upper_median(v):
+    """The median as batten takes it: the upper one for an even count, 0 when empty."""
+    return float(np.sort(v)[len(v) // 2]) if len(v) else 0.0
 
 
 def max_disp(a, b):
@@ -567,6 +595,12 @@ def peer_gcv(p, sigma_hat):  # noqa: ARG001
 
 
 def peer_splprep(p, sigma_hat, closed=False):
+    with warnings.catch_warnings():  # FITPACK's "s too small" warnings: the result is measured as it is
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return _splprep(p, sigma_hat, closed)
+
+
+def _splprep(p, sigma_hat, closed):
     t = chord(p, closed)
     if closed:
         q = np.vstack([p, p[:1]])
@@ -586,7 +620,7 @@ def peer_occt(p, sigma_hat):
     sorted (tangential noise can swap neighbours' parameters; the curve is the same, and the
     points come out in order along it), runs of equal parameters spread (`spread_ties`)."""
     n = len(p)
-    tol = 3.0 * sigma_hat
+    tol = TOL_FACTOR * sigma_hat
     line = AppDef_MultiLine(n)
     for i, (x, y) in enumerate(p):
         mpc = AppDef_MultiPointConstraint(0, 1)
@@ -641,6 +675,15 @@ def spread_ties(us):
 
 
 # ================================================================ one noisy curve
+def batten_tolerance(tol_mode, diag, sigma_hat, sigma=None):
+    """The `--tolerance` argument for batten: 3σ̂ as a number (`hat3`), the word `auto` (batten
+    takes k·σ̂ itself, k = 3 unless the method has its own: the same figure with the same
+    estimator), or 3σ with the true σ. Numbers are floored as batten floors `auto`."""
+    if tol_mode == "auto":
+        return "auto"
+    return repr(max(TOL_FACTOR * (sigma if tol_mode == "true3" else sigma_hat), AUTO_TOLERANCE_FLOOR_REL * diag))
+
+
 def noisy_case(task):
     """Run every tool on one noisy curve; returns the result rows."""
     split, fi, n, noise, seed, methods, peers, tol_mode, limits, timeout = task
@@ -658,7 +701,7 @@ def noisy_case(task):
     window = max(MATCH_FRACTION, MATCH_SPACINGS / (n - 1))
     sig_hat = noise_sigma(noisy)
     peer_sigma = sigma if tol_mode == "true3" else sig_hat
-    tol_arg = repr(3.0 * sigma) if tol_mode == "true3" else "auto"
+    tol_arg = batten_tolerance(tol_mode, diag, sig_hat, sigma)
     base = dict(split=split, family=fam.name, n=n, noise=noise, sigma=sigma, seed=seed, true_inflections=len(true_pos),
                 noise_sigma_hat=sig_hat)
     rows = []
@@ -692,24 +735,27 @@ def noisy_case(task):
         rows.append(row)
         return md
 
+    def skipped(tool, limit_key):
+        """Whether --limit leaves `tool` out at this n (then recorded as skipped)."""
+        if limit_key in limits and n > limits[limit_key]:
+            rows.append(dict(base, tool=tool, matched_to="", status="skipped", note=f"n > {limits[limit_key]}"))
+            return True
+        return False
+
     with tempfile.TemporaryDirectory() as tmp:
         measure("input", "", noisy, "ok", 0.0, None)
         for spec in methods:
-            name = spec.partition("[")[0]
-            if name in limits and n > limits[name]:
-                rows.append(dict(base, tool=spec, matched_to="", status="skipped", note=f"n > {limits[name]}"))
+            if skipped(spec, spec.partition("[")[0]):
                 continue
             pts, status, dt, rep, msg = run_batten(spec, noisy, tol_arg, tmp, timeout)
             tol = rep.get("tolerance") if rep else None
             md = measure(spec, "", pts, status, dt, tol, msg if status != "ok" else "", rep)
-            if md is not None and "csaps" in peers:
+            if md is not None and "csaps" in peers and not skipped(f"csaps@{spec}", "csaps"):
                 run_peer(measure, f"csaps@{spec}", spec, peer_csaps, (noisy, md), md, timeout)
-        if "gcv" in peers:
-            run_peer(measure, "gcv", "", peer_gcv, (noisy, peer_sigma), None, timeout)
-        if "splprep" in peers:
-            run_peer(measure, "splprep", "", peer_splprep, (noisy, peer_sigma), None, timeout)
-        if "occt" in peers:
-            run_peer(measure, "occt", "", peer_occt, (noisy, peer_sigma), 3.0 * peer_sigma, timeout)
+        for tool, fn, tol in (("gcv", peer_gcv, None), ("splprep", peer_splprep, None),
+                              ("occt", peer_occt, TOL_FACTOR * peer_sigma)):
+            if tool in peers and not skipped(tool, tool):
+                run_peer(measure, tool, "", fn, (noisy, peer_sigma), tol, timeout)
     return rows
 
 
@@ -788,7 +834,7 @@ def clean_cases():
 
 
 def clean_case(task):
-    label, pts, k_true, closed, methods, peers, limits, timeout = task
+    label, pts, k_true, closed, methods, peers, limits, timeout, tol_mode = task
     rows = []
     diag = float(np.hypot(*(pts.max(0) - pts.min(0))))
     k_rms = float(np.sqrt(np.mean(k_true**2)))
@@ -820,7 +866,9 @@ def clean_case(task):
             name = spec.partition("[")[0]
             if name in limits and len(pts) > limits[name]:
                 continue
-            for tol_label, tol in (("auto", "auto"), (f"{CLEAN_FIXED_TOL:.1%} diag", repr(CLEAN_FIXED_TOL * diag))):
+            auto = batten_tolerance("auto" if tol_mode == "auto" else "hat3", diag, sig_hat)
+            for tol_label, tol in (("auto" if auto == "auto" else "3σ̂", auto),
+                                   (f"{CLEAN_FIXED_TOL:.1%} diag", repr(CLEAN_FIXED_TOL * diag))):
                 out, status, _, _, msg = run_batten(spec, pts, tol, tmp, timeout, closed)
                 record(spec, tol_label, out, status, msg if status != "ok" else "")
         for tool, fn in (("gcv", peer_gcv), ("splprep", peer_splprep), ("occt", peer_occt)):
@@ -850,7 +898,8 @@ def summarize(rows):
         out[tool] = dict(
             curves=len(rs),
             measured=len(ms),
-            failed=sum(r["status"] in ("failed", "failed_output", "timeout") for r in rs),
+            failed=sum(r["status"] in ("failed", "timeout") for r in rs),
+            exit1=sum(r["status"] in ("tol_missed", "failed_output") for r in rs),
             timeouts=sum(r["status"] == "timeout" for r in rs),
             skipped=sum(r["status"] == "skipped" for r in rs),
             tol_missed=sum(r["status"] == "tol_missed" for r in rs),
@@ -865,6 +914,28 @@ def summarize(rows):
             mismatch=sum(r["infl_mismatch"] for r in ms),
         )
     return out
+
+
+def cell(rows, tool, key, value):
+    """The totals of one tool over the measured rows with row[key] == value (None: no rows)."""
+    ms = [r for r in rows if r["tool"] == tool and r[key] == value and "kappa_rel" in r]
+    if not ms:
+        return None
+    return dict(curves=len(ms), spurious=sum(r["spurious"] for r in ms), with_spurious=sum(r["spurious"] > 0 for r in ms),
+                lost=sum(r["lost"] for r in ms), true=sum(r["true_inflections"] for r in ms),
+                kappa=med([r["kappa_rel"] for r in ms]))
+
+
+def clean_summary(clean_rows):
+    """Per tool: runs, runs with a violation, runs with fewer inflections, runs not measured."""
+    per = {}
+    for r in clean_rows:
+        p = per.setdefault(r["tool"], dict(runs=0, violations=0, fewer_inflections=0, not_measured=0))
+        p["runs"] += 1
+        p["violations"] += bool(r.get("violation"))
+        p["fewer_inflections"] += r.get("fewer_inflections", 0)
+        p["not_measured"] += "infl_after" not in r
+    return per
 
 
 def fmt(x, spec=".3g"):
@@ -883,7 +954,8 @@ def markdown(rows, clean_rows, args, meta):
              "inflections with no true one in the window; *curves w/ any*: curves with at least one; "
              "*lost*: true inflections with no result one (of the total true count); *κ err*: median over "
              "curves of RMS(κ − κ_true)/RMS(κ_true); *max disp*: median max displacement in units of the true σ; "
-             "*over tol*: results farther than their tolerance (batten: the report's; occt: 3σ̂; "
+             "*failed*: no measurable result (exit 1, a missed tolerance with the output written, is measured "
+             "and counted apart); *over tol*: results farther than their tolerance (batten: the report's; occt: its Tol2D; "
              "csaps: the matched displacement); *time*: median wall time (batten: the whole CLI run, one "
              "thread; csaps: the bisection).\n")
     summ = summarize(rows)
@@ -892,7 +964,7 @@ def markdown(rows, clean_rows, args, meta):
     L.append("|---|---|---|---|---|---|---|---|---|---|")
     for tool, s in summ.items():
         failed = f"{s['failed']}" + (f" ({s['timeouts']} timeouts)" if s["timeouts"] else "") + \
-            (f", {s['skipped']} skipped" if s["skipped"] else "")
+            (f", {s['skipped']} skipped" if s["skipped"] else "") + (f", {s['exit1']} exit 1" if s["exit1"] else "")
         L.append(f"| {tool} | {s['measured']} | {failed} | {s['spurious']} | {s['with_spurious']} | "
                  f"{s['lost']} / {s['true']} | {fmt(s['kappa'])} | {fmt(s['disp'])} | {s['over_tol']} | "
                  f"{fmt(1e3 * s['time'] if s['measured'] else float('nan'), '.1f')} |")
@@ -907,6 +979,11 @@ def markdown(rows, clean_rows, args, meta):
                 continue
             L.append(f"| {tool} | {s['spurious']} | {fmt(s['kappa'])} | {'yes' if s['spurious'] < o['spurious'] else 'no'} | "
                      f"{'yes' if s['kappa'] <= o['kappa'] else 'no'} | {s['curves'] - s['measured']} |")
+    rel = [abs(r["noise_sigma_report"] - r["noise_sigma_hat"]) / r["noise_sigma_hat"] for r in rows
+           if r.get("noise_sigma_report") is not None and r["noise_sigma_hat"] > 0]
+    if rel:
+        L.append(f"\nσ̂ computed here and the `noise_sigma` of batten's reports differ by at most {max(rel):.1e} "
+                 f"(relative, {len(rel)} reports); σ̂/σ: median {med([r['noise_sigma_hat'] / r['sigma'] for r in rows if r['tool'] == 'input']):.3f}.")
     mism = sum(s["mismatch"] for s in summ.values())
     L.append(f"\nInflection counts here and in `batten analyze` disagreed on {mism} results "
              "(the counts above are `analyze`'s).\n")
@@ -923,12 +1000,9 @@ def markdown(rows, clean_rows, args, meta):
         for tool in tools:
             cells = []
             for v in values:
-                ms = [r for r in rows if r["tool"] == tool and r[key] == v and "kappa_rel" in r]
-                if not ms:
-                    cells.append("–")
-                    continue
-                cells.append(f"{sum(r['spurious'] for r in ms)} ({sum(r['spurious'] > 0 for r in ms)}) / "
-                             f"{sum(r['lost'] for r in ms)} / {fmt(med([r['kappa_rel'] for r in ms]), '.2g')}")
+                c = cell(rows, tool, key, v)
+                cells.append("–" if c is None else
+                             f"{c['spurious']} ({c['with_spurious']}) / {c['lost']} / {fmt(c['kappa'], '.2g')}")
             L.append(f"| {tool} | " + " | ".join(cells) + " |")
         L.append("")
     L.append("## True inflections per family\n")
@@ -956,20 +1030,14 @@ def markdown(rows, clean_rows, args, meta):
         L.append("Exact samples; a violation is more inflections or vibrations than the input, or a relative "
                  f"curvature error more than {CLEAN_KAPPA_SLACK:.0%} above the input's own. "
                  "Tolerance `auto` (3σ̂) and a fixed one of 0.5 % of the diagonal.\n")
-        per = defaultdict(lambda: [0, 0, 0, 0])
-        for r in clean_rows:
-            p = per[r["tool"]]
-            p[0] += 1
-            p[1] += bool(r.get("violation"))
-            p[2] += r.get("fewer_inflections", 0)
-            p[3] += "infl_after" not in r
+        per = clean_summary(clean_rows)
         L.append("*fewer inflections*: runs that removed inflections of the exact samples (not counted as "
                  "violations: the sine's and the clothoid's ends sit at zeros of κ, where the spline's sign "
                  "changes are marginal).\n")
         L.append("| tool | runs | with a violation | fewer inflections | failed / not supported |")
         L.append("|---|---|---|---|---|")
-        for tool, (a, b, c, d) in per.items():
-            L.append(f"| {tool} | {a} | {b} | {c} | {d} |")
+        for tool, c in per.items():
+            L.append(f"| {tool} | {c['runs']} | {c['violations']} | {c['fewer_inflections']} | {c['not_measured']} |")
         L.append("\nViolations:\n")
         viol = [r for r in clean_rows if r.get("violation")]
         if not viol:
@@ -994,6 +1062,42 @@ def markdown(rows, clean_rows, args, meta):
     return "\n".join(L)
 
 
+def json_safe(x):
+    """NaN and infinities as null, numpy scalars as Python numbers, recursively."""
+    if isinstance(x, dict):
+        return {str(k): json_safe(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [json_safe(v) for v in x]
+    if isinstance(x, np.generic):
+        x = x.item()
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    return x
+
+
+def results_json(rows, clean_rows, args, meta):
+    """Everything the Markdown shows, as data: totals and breakdowns per tool, the clean-input
+    summary and violations, and every row."""
+    summ = summarize(rows)
+    tools = list(summ)
+    fams = [f(args.split).name for f in FAMILIES]
+    out = dict(
+        meta=dict(meta, split=args.split, quick=args.quick, tol_mode=args.tol_mode, noises=NOISES,
+                  match_fraction=MATCH_FRACTION, match_spacings=MATCH_SPACINGS, tol_factor=TOL_FACTOR,
+                  occt_weights=OCCT_WEIGHTS, true_inflections={f(args.split).name: len(f(args.split).inflections())
+                                                                for f in FAMILIES}),
+        totals=summ,
+        per_family={t: {v: cell(rows, t, "family", v) for v in fams} for t in tools},
+        per_n={t: {str(v): cell(rows, t, "n", v) for v in meta["sizes_list"]} for t in tools},
+        per_noise={t: {str(v): cell(rows, t, "noise", v) for v in NOISES} for t in tools},
+        rows=rows,
+    )
+    if clean_rows is not None:
+        out["clean"] = dict(summary=clean_summary(clean_rows), violations=[r for r in clean_rows if r.get("violation")],
+                            rows=clean_rows)
+    return json_safe(out)
+
+
 def write_rows_csv(path, rows):
     keys = list(dict.fromkeys(k for r in rows for k in r))
     with open(path, "w", newline="") as f:
@@ -1014,7 +1118,11 @@ def main():
     ap.add_argument("--quick", action="store_true", help="n ∈ {30, 300}, one seed")
     ap.add_argument("--methods", default=None, help="comma-separated batten method specs (default: all)")
     ap.add_argument("--peers", default=None, help="csaps,gcv,splprep,occt or none (default: all available)")
-    ap.add_argument("--tol-mode", choices=["auto", "true3"], default="auto")
+    ap.add_argument("--tol-mode", choices=["hat3", "auto", "true3"], default="hat3",
+                    help="batten's --tolerance: hat3 = 3σ̂ as a number (default; any binary), auto = the word "
+                    "`auto` (batten estimates σ̂ itself; band's default), true3 = 3σ with the true σ")
+    ap.add_argument("--auto", dest="tol_mode", action="store_const", const="auto",
+                    help="short for --tol-mode auto: pass --tolerance auto to batten")
     ap.add_argument("--limit", default="", help="METHOD=NMAX,...: skip METHOD above NMAX points")
     ap.add_argument("--timeout", type=float, default=60.0, help="seconds per run")
     ap.add_argument("--jobs", type=int, default=2)
@@ -1023,6 +1131,7 @@ def main():
     ap.add_argument("--no-clean", action="store_true", help="skip the clean-input check")
     ap.add_argument("--out", default=None)
     ap.add_argument("--csv", default=None)
+    ap.add_argument("--json", default=None, help="also write the totals, breakdowns and rows as JSON to this file")
     args = ap.parse_args()
 
     if not os.path.exists(BATTEN):
@@ -1033,8 +1142,9 @@ def main():
     known = batten_methods()
     for m in methods:
         method_args(m)
-        if m.partition("[")[0] not in known:
-            raise SystemExit(f"{BATTEN} has no method {m.partition('[')[0]!r}; it has {', '.join(known)}")
+        if m.partition("[")[0] not in known:  # measured anyway: every run of it is reported as failed
+            print(f"warning: {BATTEN} does not list method {m.partition('[')[0]!r} (it has {', '.join(known)}); "
+                  "its runs will be reported as failures", file=sys.stderr)
     available = ["csaps"] * (csaps is not None) + ["gcv", "splprep"] + ["occt"] * HAVE_OCCT
     peer_note = "" if HAVE_OCCT else " (OCP not installed: `pip install cadquery-ocp-novtk` for occt)"
     if args.peers is None:
@@ -1074,7 +1184,7 @@ def main():
                 print(f"{k}/{len(tasks)} curves, {time.time() - t0:.0f} s", file=sys.stderr)
         clean_rows = None
         if not args.no_clean:
-            ctasks = [(label, pts, k, closed, methods, peers, limits, args.timeout)
+            ctasks = [(label, pts, k, closed, methods, peers, limits, args.timeout, args.tol_mode)
                       for label, pts, k, closed in clean_cases()]
             clean_rows = [r for rs in pool.imap(clean_case, ctasks) for r in rs]
     wall = time.time() - t0
@@ -1091,8 +1201,12 @@ def main():
     write_rows_csv(out_csv, rows)
     if clean_rows is not None:
         write_rows_csv(os.path.splitext(out_csv)[0] + "-clean.csv", clean_rows)
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(results_json(rows, clean_rows, args, meta), f, indent=1, ensure_ascii=False)
+            f.write("\n")
     print(text)
-    print(f"\nwrote {out_md} and {out_csv}", file=sys.stderr)
+    print(f"\nwrote {out_md}, {out_csv}" + (f" and {args.json}" if args.json else ""), file=sys.stderr)
 
 
 if __name__ == "__main__":
