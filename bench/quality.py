@@ -1029,7 +1029,8 @@ def markdown(rows, clean_rows, args, meta):
         L.append("## Clean input\n")
         L.append("Exact samples; a violation is more inflections or vibrations than the input, or a relative "
                  f"curvature error more than {CLEAN_KAPPA_SLACK:.0%} above the input's own. "
-                 "Tolerance `auto` (3σ̂) and a fixed one of 0.5 % of the diagonal.\n")
+                 f"Tolerance 3σ̂ ({'`--tolerance auto`' if args.tol_mode == 'auto' else 'as a number, floored at 1e-12 of the diagonal'}) "
+                 "and a fixed one of 0.5 % of the diagonal.\n")
         per = clean_summary(clean_rows)
         L.append("*fewer inflections*: runs that removed inflections of the exact samples (not counted as "
                  "violations: the sine's and the clothoid's ends sit at zeros of κ, where the spline's sign "
