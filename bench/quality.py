@@ -112,9 +112,9 @@ import warnings  # noqa: E402
 from collections import defaultdict  # noqa: E402
 
 import numpy as np  # noqa: E402
-from scipy.interpolate import CubicSpline, make_smoothing_spline, splev, splprep
-from scipy.optimize import brentq
-from scipy.special import fresnel
+from scipy.interpolate import CubicSpline, make_smoothing_spline, splev, splprep  # noqa: E402
+from scipy.optimize import brentq  # noqa: E402
+from scipy.special import fresnel  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from compare_peers import method_args  # noqa: E402  (one parser for method specs)
