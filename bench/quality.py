@@ -55,9 +55,11 @@ Peers (each result is a set of output points, one per input point):
   - `splprep`: SciPy `splprep` (cubic, u = chord length) with s = 2·n·σ̂²: the expected sum of
     squared residuals of the exact curve for noise σ̂ per coordinate in two coordinates;
   - `occt`: Open CASCADE variational smoothing, `Geom2dAPI_PointsToBSpline(points, 0.4, 0.2,
-    0.4, DegMax 8, C2, Tol2D = 3·σ̂)` (PyPI cadquery-ocp-novtk or cadquery-ocp); the output
-    point i is the projection of input point i on the curve (nearest point, searched near the
-    chord-length parameter and refined by Newton's method). Skipped when OCP is not installed.
+    0.4, DegMax 8, C2, Tol2D = 3·σ̂)` (PyPI cadquery-ocp-novtk or cadquery-ocp), built from
+    its parts (`AppDef_Variational`, as the API builds it); the output point i is the curve at
+    the i-th of the parameters the fit gave the points, sorted, ties spread (`peer_occt`).
+    Skipped when OCP is not installed.
+    At start, `check_occt` checks that these points lie on the curve the API itself returns.
 σ̂ is batten's noise estimate (`analysis/noise.rs`, ported here as `noise_sigma` and checked
 against the `noise_sigma` in batten's reports: the Markdown gives the largest difference);
 with `--tol-mode true3` the true σ.
@@ -153,6 +155,7 @@ OCCT_WEIGHTS = (0.4, 0.2, 0.4)
 OCCT_DEGMAX = 8
 MAD_TO_SIGMA = 1.4826  # the MAD-to-σ factor for Gaussian noise
 NORMAL_CHORD_NOISE_SPANS = 20.0  # batten's: the normal's chord spans about this many rough noise scales
+OCCT_CHECK_REL = 1e-9  # check_occt: the peer's points on the API's curve to this fraction of the diagonal
 OCCT_TIE_GAP = 1e-9  # parameters closer than this fraction of the range count as one (spread_ties)
 
 
@@ -653,6 +656,34 @@ def peer_occt(p, sigma_hat):
     return out
 
 
+def check_occt():
+    """`peer_occt` against `Geom2dAPI_PointsToBSpline` itself on a noisy sine: its points must lie
+    on the API's curve (the setup above is meant to be the API's, with the parameters exposed)."""
+    try:
+        from OCP.Geom2dAPI import Geom2dAPI_PointsToBSpline, Geom2dAPI_ProjectPointOnCurve
+        from OCP.OCP.collections import Array1_gp_Pnt2d
+    except ImportError:  # pragma: no cover — another OCP layout: nothing to compare with
+        return
+    f = fam_sine("test")
+    p = f.points(np.linspace(f.t0, f.t1, 200)) + np.random.default_rng(0).normal(0.0, 0.05, (200, 2))
+    sigma_hat = noise_sigma(p)
+    arr = Array1_gp_Pnt2d(1, len(p))
+    for i, (x, y) in enumerate(p):
+        arr.SetValue(i + 1, gp_Pnt2d(float(x), float(y)))
+    curve = Geom2dAPI_PointsToBSpline(arr, *OCCT_WEIGHTS, OCCT_DEGMAX, GeomAbs_Shape.GeomAbs_C2,
+                                      TOL_FACTOR * sigma_hat).Curve()
+    ends = [curve.Value(curve.FirstParameter()), curve.Value(curve.LastParameter())]
+
+    def distance(x, y):  # to the curve: the nearest foot of a perpendicular, else the nearer end
+        pt = gp_Pnt2d(float(x), float(y))
+        proj = Geom2dAPI_ProjectPointOnCurve(pt, curve)
+        return proj.LowerDistance() if proj.NbPoints() > 0 else min(pt.Distance(e) for e in ends)
+
+    far = max(distance(x, y) for x, y in peer_occt(p, sigma_hat))
+    if far > OCCT_CHECK_REL * float(np.hypot(*np.ptp(p, axis=0))):
+        raise SystemExit(f"occt peer: its points lie up to {far:.3g} off Geom2dAPI_PointsToBSpline's curve")
+
+
 def spread_ties(us):
     """Sorted parameters made strictly increasing: a run of (nearly) equal parameters, points
     that the fit maps to one curve point (mostly noisy end points beyond the curve's ends), is
@@ -1138,6 +1169,8 @@ def main():
     if not os.path.exists(BATTEN):
         raise SystemExit(f"no batten binary at {BATTEN}: build it (cargo build --release -p batten-cli) or set BATTEN_BIN")
     check_families(args.split)
+    if HAVE_OCCT:
+        check_occt()
     methods = [m.strip() for m in args.methods.split(",")] if args.methods else batten_methods()
     methods = [m for m in methods if m]
     known = batten_methods()
