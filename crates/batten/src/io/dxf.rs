@@ -1,0 +1,535 @@
+//! DXF (`.dxf`, ASCII or binary), through the `dxf` crate.
+//!
+//! Reading takes the curve entities of the drawing's model and paper space:
+//! - `LWPOLYLINE`: its vertices as points (closed flag kept; its elevation is the z);
+//! - `POLYLINE` (2-D or 3-D; not meshes): its vertices as points, without the frame
+//!   control points of a spline-fit polyline;
+//! - `SPLINE`: its degree, knots, control points and weights as a B-spline; or, when it has
+//!   no control points, its fit points as points.
+//!
+//! Which entity: the one with handle [`Pick::entity`], else the only one on layer
+//! [`Pick::layer`], else the only curve entity of the file; otherwise the error lists them.
+//! batten fairs planar curves: every point must have the same z, which is written back;
+//! a curve whose z varies, arc segments (bulges) and entities in an object coordinate
+//! system other than the world's (extrusion not +z) are refused.
+//!
+//! Writing: points as an `LWPOLYLINE` with the elevation and layer of the input, a B-spline
+//! as a `SPLINE` (degree, knots, control points, weights; rational and closed flags), in an
+//! R2000 drawing. The `dxf` crate writes ASCII numbers with 12 decimal places, so a written
+//! file reads back within 5·10⁻¹³ of each coordinate, not bit for bit.
+
+use std::path::Path;
+
+use dxf::entities::{Entity, EntityType, LwPolyline, Spline};
+use dxf::enums::AcadVersion;
+use dxf::{Drawing, LwPolylineVertex};
+
+use super::{IoError, Location, Origin, Pick, Raw};
+use crate::geom::Point;
+use crate::spline::{BSplineCurve, KnotVector};
+
+/// POLYLINE flag: the vertices are 3-D.
+const POLYLINE_3D: i32 = 8;
+/// POLYLINE flags of meshes, which are not curves.
+const POLYLINE_MESH: i32 = 16 | 64;
+/// VERTEX flag: a frame control point of a spline-fit polyline (not on the curve).
+const VERTEX_FRAME: i32 = 16;
+/// SPLINE flag: planar.
+const SPLINE_PLANAR: i32 = 8;
+
+fn format_err(path: &Path, message: impl Into<String>) -> IoError {
+    IoError::Format {
+        path: path.to_path_buf(),
+        at: Location::File,
+        message: message.into(),
+    }
+}
+
+/// A curve entity of the drawing: its handle, layer and kind.
+pub(crate) struct Found<'a> {
+    pub entity: &'a Entity,
+    pub kind: &'static str,
+}
+
+impl Found<'_> {
+    pub fn handle(&self) -> String {
+        format!("{:X}", self.entity.common.handle.0)
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "{} {} on layer {}",
+            self.kind,
+            self.handle(),
+            self.entity.common.layer
+        )
+    }
+}
+
+/// Load a drawing from bytes.
+pub(crate) fn load(bytes: &[u8], path: &Path) -> Result<Drawing, IoError> {
+    let mut reader = bytes;
+    Drawing::load(&mut reader).map_err(|e| format_err(path, format!("malformed DXF: {e}")))
+}
+
+/// The curve entities of a drawing, in file order.
+pub(crate) fn curves(drawing: &Drawing) -> Vec<Found<'_>> {
+    drawing
+        .entities()
+        .filter_map(|e| {
+            let kind = match &e.specific {
+                EntityType::LwPolyline(_) => "LWPOLYLINE",
+                EntityType::Polyline(p) if p.flags & POLYLINE_MESH == 0 => "POLYLINE",
+                EntityType::Spline(_) => "SPLINE",
+                _ => return None,
+            };
+            Some(Found { entity: e, kind })
+        })
+        .collect()
+}
+
+/// Read the picked curve of a DXF file.
+pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Origin), IoError> {
+    let drawing = load(bytes, path)?;
+    let all = curves(&drawing);
+    let list = |v: &[&Found<'_>]| {
+        v.iter()
+            .map(|f| f.describe())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut chosen: Vec<&Found<'_>> = all.iter().collect();
+    if let Some(h) = &pick.entity {
+        let want = h.trim().trim_start_matches("0x").to_ascii_uppercase();
+        chosen.retain(|f| f.handle() == want.trim_start_matches('0') || f.handle() == want);
+        if chosen.is_empty() {
+            return Err(format_err(
+                path,
+                format!(
+                    "no curve entity with handle {h} (curve entities: {})",
+                    if all.is_empty() {
+                        "none".into()
+                    } else {
+                        list(&all.iter().collect::<Vec<_>>())
+                    }
+                ),
+            ));
+        }
+    }
+    if let Some(layer) = &pick.layer {
+        chosen.retain(|f| f.entity.common.layer == *layer);
+        if chosen.is_empty() {
+            return Err(format_err(
+                path,
+                format!(
+                    "no curve entity on layer {layer} (curve entities: {})",
+                    if all.is_empty() {
+                        "none".into()
+                    } else {
+                        list(&all.iter().collect::<Vec<_>>())
+                    }
+                ),
+            ));
+        }
+    }
+    let found = match chosen.as_slice() {
+        [] => {
+            return Err(format_err(path, "no LWPOLYLINE, POLYLINE or SPLINE entity"));
+        }
+        [f] => *f,
+        many => {
+            return Err(format_err(
+                path,
+                format!(
+                    "{} curve entities, pick one with --entity HANDLE or --layer NAME: {}",
+                    many.len(),
+                    list(many)
+                ),
+            ));
+        }
+    };
+    let raw_z = entity_curve(found, path)?;
+    let origin = Origin {
+        z: raw_z.1,
+        layer: Some(found.entity.common.layer.clone()),
+        name: Some(found.handle()),
+    };
+    Ok((raw_z.0, origin))
+}
+
+/// One entity as points or a B-spline, with its constant z.
+pub(crate) fn entity_curve(found: &Found<'_>, path: &Path) -> Result<(Raw, f64), IoError> {
+    let e = found.entity;
+    let what = found.describe();
+    let err = |m: String| format_err(path, format!("{what}: {m}"));
+    let extrusion = |v: &dxf::Vector| {
+        if v.x == 0.0 && v.y == 0.0 && v.z > 0.0 {
+            Ok(())
+        } else {
+            Err(err(format!(
+                "its plane has the normal ({}, {}, {}); batten takes curves in the world XY plane only",
+                v.x, v.y, v.z
+            )))
+        }
+    };
+    let planar = |zs: &mut dyn Iterator<Item = f64>| -> Result<f64, IoError> {
+        let mut z0 = None;
+        for z in zs {
+            match z0 {
+                None => z0 = Some(z),
+                Some(a) if a == z => {}
+                Some(a) => {
+                    return Err(err(format!(
+                        "z varies ({a} and {z}): 3-D curves are not supported yet"
+                    )));
+                }
+            }
+        }
+        Ok(z0.unwrap_or(0.0))
+    };
+    match &e.specific {
+        EntityType::LwPolyline(lw) => {
+            extrusion(&lw.extrusion_direction)?;
+            if let Some(i) = lw.vertices.iter().position(|v| v.bulge != 0.0) {
+                return Err(err(format!(
+                    "vertex {} starts an arc segment (bulge); batten takes straight segments only",
+                    i + 1
+                )));
+            }
+            let mut points: Vec<Point> = lw.vertices.iter().map(|v| Point::new(v.x, v.y)).collect();
+            let closed = lw.is_closed();
+            if closed && points.len() > 1 && points.last() == points.first() {
+                points.pop();
+            }
+            let lines = vec![1; points.len()];
+            Ok((
+                Raw::Points {
+                    points,
+                    lines,
+                    closed,
+                },
+                e.common.elevation,
+            ))
+        }
+        EntityType::Polyline(pl) => {
+            extrusion(&pl.normal)?;
+            let verts: Vec<_> = pl
+                .vertices()
+                .filter(|v| v.flags & VERTEX_FRAME == 0)
+                .collect();
+            if let Some(i) = verts.iter().position(|v| v.bulge != 0.0) {
+                return Err(err(format!(
+                    "vertex {} starts an arc segment (bulge); batten takes straight segments only",
+                    i + 1
+                )));
+            }
+            let z = if pl.flags & POLYLINE_3D != 0 {
+                planar(&mut verts.iter().map(|v| v.location.z))?
+            } else {
+                pl.location.z
+            };
+            let mut points: Vec<Point> = verts
+                .iter()
+                .map(|v| Point::new(v.location.x, v.location.y))
+                .collect();
+            let closed = pl.is_closed();
+            if closed && points.len() > 1 && points.last() == points.first() {
+                points.pop();
+            }
+            let lines = vec![1; points.len()];
+            Ok((
+                Raw::Points {
+                    points,
+                    lines,
+                    closed,
+                },
+                z,
+            ))
+        }
+        EntityType::Spline(sp) => {
+            extrusion(&sp.normal)?;
+            if sp.control_points.is_empty() {
+                let z = planar(&mut sp.fit_points.iter().map(|p| p.z))?;
+                let mut points: Vec<Point> =
+                    sp.fit_points.iter().map(|p| Point::new(p.x, p.y)).collect();
+                let closed = sp.is_closed();
+                if closed && points.len() > 1 && points.last() == points.first() {
+                    points.pop();
+                }
+                let lines = vec![1; points.len()];
+                return Ok((
+                    Raw::Points {
+                        points,
+                        lines,
+                        closed,
+                    },
+                    z,
+                ));
+            }
+            let z = planar(&mut sp.control_points.iter().map(|p| p.z))?;
+            let degree = usize::try_from(sp.degree_of_curve)
+                .map_err(|_| err(format!("degree {} is not a degree", sp.degree_of_curve)))?;
+            let ctrl: Vec<Point> = sp
+                .control_points
+                .iter()
+                .map(|p| Point::new(p.x, p.y))
+                .collect();
+            let weights = if sp.weight_values.is_empty() {
+                None
+            } else {
+                Some(sp.weight_values.clone())
+            };
+            let curve = KnotVector::try_new(sp.knot_values.clone())
+                .and_then(|k| BSplineCurve::try_new(degree, k, ctrl, weights))
+                .map_err(|e| err(e.to_string()))?;
+            Ok((Raw::Curve(curve), z))
+        }
+        _ => Err(err("not a curve entity".into())),
+    }
+}
+
+/// A new R2000 drawing holding `entity` on the origin's layer.
+fn drawing_with(mut entity: Entity, origin: &Origin) -> Drawing {
+    let mut drawing = Drawing::new();
+    drawing.header.version = AcadVersion::R2000;
+    let layer = origin.layer.clone().unwrap_or_else(|| "0".to_string());
+    if !drawing.layers().any(|l| l.name == layer) {
+        let l = dxf::tables::Layer {
+            name: layer.clone(),
+            ..Default::default()
+        };
+        drawing.add_layer(l);
+    }
+    entity.common.layer = layer;
+    drawing.add_entity(entity);
+    drawing
+}
+
+fn save(drawing: &Drawing, path: &Path) -> Result<Vec<u8>, IoError> {
+    let mut out = Vec::new();
+    drawing
+        .save(&mut out)
+        .map_err(|e| format_err(path, format!("cannot encode the DXF: {e}")))?;
+    Ok(out)
+}
+
+/// Points as an LWPOLYLINE.
+pub(crate) fn format_points(
+    points: &[Point],
+    closed: bool,
+    origin: &Origin,
+    path: &Path,
+) -> Result<Vec<u8>, IoError> {
+    let mut lw = LwPolyline::default();
+    lw.vertices = points
+        .iter()
+        .map(|p| LwPolylineVertex {
+            x: p.x,
+            y: p.y,
+            ..Default::default()
+        })
+        .collect();
+    lw.set_is_closed(closed);
+    let mut entity = Entity::new(EntityType::LwPolyline(lw));
+    entity.common.elevation = origin.z;
+    save(&drawing_with(entity, origin), path)
+}
+
+/// A B-spline as a SPLINE.
+pub(crate) fn format_curve(
+    curve: &BSplineCurve,
+    closed: bool,
+    origin: &Origin,
+    path: &Path,
+) -> Result<Vec<u8>, IoError> {
+    let mut sp = Spline::default();
+    sp.degree_of_curve = i32::try_from(curve.degree())
+        .map_err(|_| format_err(path, "the degree does not fit a DXF integer"))?;
+    sp.knot_values = curve.knots().as_slice().to_vec();
+    sp.control_points = curve
+        .control_points()
+        .iter()
+        .map(|p| dxf::Point::new(p.x, p.y, origin.z))
+        .collect();
+    sp.weight_values = curve.weights().map(<[f64]>::to_vec).unwrap_or_default();
+    sp.flags = SPLINE_PLANAR;
+    sp.set_is_rational(curve.weights().is_some());
+    sp.set_is_closed(closed);
+    sp.normal = dxf::Vector::z_axis();
+    save(
+        &drawing_with(Entity::new(EntityType::Spline(sp)), origin),
+        path,
+    )
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    /// Within the 12 decimal places the `dxf` crate writes.
+    const DXF_ROUNDING: f64 = 5.0e-13;
+
+    fn read(bytes: &[u8], pick: &Pick) -> Result<(Raw, Origin), String> {
+        parse(bytes, Path::new("d.dxf"), pick).map_err(|e| e.to_string())
+    }
+
+    fn pts() -> Vec<Point> {
+        (0..6)
+            .map(|i| Point::new(i as f64 * 1.25, ((i * i) % 7) as f64 / 3.0))
+            .collect()
+    }
+
+    fn close(a: Point, b: Point) -> bool {
+        let near = |u: f64, v: f64| (u - v).abs() <= DXF_ROUNDING + f64::EPSILON * v.abs();
+        near(a.x, b.x) && near(a.y, b.y)
+    }
+
+    #[test]
+    fn polyline_round_trip_keeps_points_z_layer_and_closedness() {
+        let origin = Origin {
+            z: 2.5,
+            layer: Some("HULL".into()),
+            name: None,
+        };
+        for closed in [false, true] {
+            let bytes = format_points(&pts(), closed, &origin, Path::new("o.dxf")).unwrap();
+            let (raw, o) = read(&bytes, &Pick::default()).unwrap();
+            let Raw::Points {
+                points, closed: c, ..
+            } = raw
+            else {
+                panic!()
+            };
+            assert_eq!(c, closed);
+            assert_eq!(points.len(), 6);
+            assert!(points.iter().zip(pts()).all(|(a, b)| close(*a, b)));
+            assert_eq!(o.z, 2.5);
+            assert_eq!(o.layer.as_deref(), Some("HULL"));
+        }
+    }
+
+    #[test]
+    fn spline_round_trip_keeps_degree_knots_and_weights() {
+        let knots = KnotVector::try_new(vec![0., 0., 0., 0.5, 1., 1., 1.]).unwrap();
+        let ctrl = vec![
+            Point::new(0.0, 0.0),
+            Point::new(1.0, 2.0),
+            Point::new(2.0, -1.0 / 3.0),
+            Point::new(3.0, 0.5),
+        ];
+        let c =
+            BSplineCurve::try_new(2, knots, ctrl.clone(), Some(vec![1.0, 0.5, 2.0, 1.0])).unwrap();
+        let bytes = format_curve(&c, false, &Origin::default(), Path::new("o.dxf")).unwrap();
+        let (raw, o) = read(&bytes, &Pick::default()).unwrap();
+        let Raw::Curve(back) = raw else { panic!() };
+        assert_eq!(back.degree(), 2);
+        assert_eq!(back.knots(), c.knots());
+        assert_eq!(back.weights(), c.weights());
+        assert!(
+            back.control_points()
+                .iter()
+                .zip(&ctrl)
+                .all(|(a, b)| close(*a, *b))
+        );
+        assert_eq!(o.z, 0.0);
+    }
+
+    fn two_entities() -> Vec<u8> {
+        let mut d = Drawing::new();
+        d.header.version = AcadVersion::R2000;
+        for (layer, z) in [("A", 0.0), ("B", 1.0)] {
+            let mut lw = LwPolyline::default();
+            lw.vertices = pts()
+                .iter()
+                .map(|p| LwPolylineVertex {
+                    x: p.x,
+                    y: p.y,
+                    ..Default::default()
+                })
+                .collect();
+            let mut e = Entity::new(EntityType::LwPolyline(lw));
+            e.common.layer = layer.into();
+            e.common.elevation = z;
+            d.add_entity(e);
+        }
+        let mut sp = Spline::default();
+        sp.degree_of_curve = 3;
+        sp.fit_points = (0..5)
+            .map(|i| dxf::Point::new(f64::from(i), 0.0, f64::from(i)))
+            .collect();
+        let mut e = Entity::new(EntityType::Spline(sp));
+        e.common.layer = "C".into();
+        d.add_entity(e);
+        let mut out = Vec::new();
+        d.save(&mut out).unwrap();
+        out
+    }
+
+    #[test]
+    fn picking_by_handle_or_layer_and_the_ambiguity_message() {
+        let bytes = two_entities();
+        let e = read(&bytes, &Pick::default()).unwrap_err();
+        assert!(e.starts_with("d.dxf: 3 curve entities, pick one with --entity HANDLE or --layer NAME: LWPOLYLINE "), "{e}");
+        assert!(e.contains(" on layer A, LWPOLYLINE "), "{e}");
+        let (_, o) = read(&bytes, &Pick::default().with_layer(Some("B".into()))).unwrap();
+        assert_eq!(o.z, 1.0);
+        let handle = o.name.unwrap();
+        let (_, o2) = read(
+            &bytes,
+            &Pick::default().with_entity(Some(handle.to_lowercase())),
+        )
+        .unwrap();
+        assert_eq!(o2.layer.as_deref(), Some("B"));
+        let e = read(&bytes, &Pick::default().with_layer(Some("X".into()))).unwrap_err();
+        assert!(
+            e.starts_with("d.dxf: no curve entity on layer X (curve entities: "),
+            "{e}"
+        );
+        let e = read(&bytes, &Pick::default().with_layer(Some("C".into()))).unwrap_err();
+        assert!(
+            e.contains("z varies (0 and 1): 3-D curves are not supported yet"),
+            "{e}"
+        );
+        assert!(e.starts_with("d.dxf: SPLINE "), "{e}");
+    }
+
+    #[test]
+    fn bulges_and_garbage_are_refused() {
+        let mut d = Drawing::new();
+        d.header.version = AcadVersion::R2000;
+        let mut lw = LwPolyline::default();
+        lw.vertices = pts()
+            .iter()
+            .enumerate()
+            .map(|(i, p)| LwPolylineVertex {
+                x: p.x,
+                y: p.y,
+                bulge: if i == 2 { 0.5 } else { 0.0 },
+                ..Default::default()
+            })
+            .collect();
+        d.add_entity(Entity::new(EntityType::LwPolyline(lw)));
+        let mut out = Vec::new();
+        d.save(&mut out).unwrap();
+        let e = read(&out, &Pick::default()).unwrap_err();
+        assert!(
+            e.ends_with(
+                "vertex 3 starts an arc segment (bulge); batten takes straight segments only"
+            ),
+            "{e}"
+        );
+        let e = read(
+            b"  0\nSECTION\n  2\nENTITIES\n  0\nLINE\n 10\nabc\n",
+            &Pick::default(),
+        )
+        .unwrap_err();
+        assert!(e.starts_with("d.dxf: malformed DXF: "), "{e}");
+        let e = read(
+            b"  0\nSECTION\n  2\nENTITIES\n  0\nENDSEC\n  0\nEOF\n",
+            &Pick::default(),
+        )
+        .unwrap_err();
+        assert_eq!(e, "d.dxf: no LWPOLYLINE, POLYLINE or SPLINE entity");
+    }
+}
