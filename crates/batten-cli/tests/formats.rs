@@ -303,7 +303,24 @@ fn format_flag_names_a_file_without_a_known_extension() {
 /// A hand-written minimal DXF (an ENTITIES section only, as many scripts write them) with
 /// two LWPOLYLINEs: handle A1 on layer HULL at z = 2.5, handle B2 on layer DECK.
 fn two_layer_dxf(dir: &Path) -> PathBuf {
+    let p = dir.join("two.dxf");
+    fs::write(&p, dxf_text(false)).unwrap();
+    p
+}
+
+/// The entities of [`two_layer_dxf`], and with `spline` a cubic SPLINE with control points,
+/// handle C3 on layer CURVES.
+fn dxf_text(spline: bool) -> String {
     let mut t = String::from("  0\nSECTION\n  2\nENTITIES\n");
+    if spline {
+        t.push_str("  0\nSPLINE\n  5\nC3\n  8\nCURVES\n 70\n8\n 71\n3\n 72\n9\n 73\n5\n 74\n0\n");
+        for k in [0.0, 0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0, 1.0] {
+            t.push_str(&format!(" 40\n{k}\n"));
+        }
+        for (x, y) in [(0.0, 0.0), (1.0, 1.0), (2.0, -1.0), (3.0, 0.5), (4.0, 0.0)] {
+            t.push_str(&format!(" 10\n{x}\n 20\n{y}\n 30\n0.0\n"));
+        }
+    }
     for (handle, layer, z, amp) in [("A1", "HULL", "2.5", 0.03), ("B2", "DECK", "0.0", 0.05)] {
         t.push_str(&format!(
             "  0\nLWPOLYLINE\n  5\n{handle}\n  8\n{layer}\n 90\n30\n 70\n0\n 38\n{z}\n"
@@ -315,9 +332,123 @@ fn two_layer_dxf(dir: &Path) -> PathBuf {
         }
     }
     t.push_str("  0\nENDSEC\n  0\nEOF\n");
-    let p = dir.join("two.dxf");
-    fs::write(&p, t).unwrap();
-    p
+    t
+}
+
+#[test]
+fn batch_fairs_every_dxf_entity_into_one_dxf() {
+    let dir = tempfile::tempdir().unwrap();
+    let (inputs, out) = (dir.path().join("in"), dir.path().join("out"));
+    fs::create_dir(&inputs).unwrap();
+    let input = inputs.join("lines.dxf");
+    fs::write(&input, dxf_text(true)).unwrap();
+    let summary = dir.path().join("summary.json");
+    let o = batten(&[
+        "batch",
+        s(&inputs),
+        "-o",
+        s(&out),
+        "--method",
+        "mst",
+        "--tolerance",
+        "0.05",
+        "--summary",
+        s(&summary),
+    ]);
+    // The SPLINE is a B-spline, which mst does not take: an invalid row, exit 2.
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(
+            "lines.dxf#C3: SPLINE with control points is a B-spline; method mst takes points"
+        ),
+        "{err}"
+    );
+    assert!(
+        err.contains(
+            "batch: 1 files, 3 curves: 2 ok, 0 tolerance exceeded, 0 failed, 1 invalid input"
+        ),
+        "{err}"
+    );
+    let rows: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&summary).unwrap()).unwrap();
+    let status: Vec<(&str, &str)> = rows
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| (r["file"].as_str().unwrap(), r["status"].as_str().unwrap()))
+        .collect();
+    let name = input.display().to_string();
+    assert_eq!(
+        status,
+        [
+            (format!("{name}#C3").as_str(), "invalid_input"),
+            (format!("{name}#A1").as_str(), "ok"),
+            (format!("{name}#B2").as_str(), "ok"),
+        ]
+    );
+    // One DXF back: handles, layers and z kept, the polylines faired, the spline as it was.
+    let written = out.join("lines.dxf");
+    let before = io::DxfDrawing::read(&input)
+        .unwrap()
+        .curves(&ReadOptions::default());
+    let after = io::DxfDrawing::read(&written)
+        .unwrap()
+        .curves(&ReadOptions::default());
+    assert_eq!(before.len(), 3);
+    for (b, a) in before.iter().zip(&after) {
+        assert_eq!(a.origin, b.origin);
+        assert_eq!(a.kind, b.kind);
+        match (b.source.as_ref().unwrap(), a.source.as_ref().unwrap()) {
+            (Source::Curve(cb), Source::Curve(ca)) => assert_eq!(ca, cb),
+            (Source::Points(pb), Source::Points(pa)) => {
+                assert_eq!(pa.seq.len(), pb.seq.len());
+                let moved = pa
+                    .seq
+                    .points()
+                    .iter()
+                    .zip(pb.seq.points())
+                    .map(|(p, q)| p.distance(*q));
+                let max = moved.fold(0.0, f64::max);
+                assert!(max > 0.0 && max <= 0.05 + 1e-12, "{max}");
+            }
+            _ => panic!("kind changed"),
+        }
+    }
+    assert_eq!(after[1].origin.z, 2.5);
+    let reports: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(out.join("lines.report.json")).unwrap()).unwrap();
+    let handles: Vec<&str> = reports
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["handle"].as_str().unwrap())
+        .collect();
+    assert_eq!(handles, ["A1", "B2"]);
+    assert_eq!(reports[0]["layer"], "HULL");
+    assert_eq!(reports[0]["report"]["tolerance_met"], true);
+
+    // salvi takes the SPLINE as a B-spline: knots and degree kept, control points moved.
+    let o = batten(&[
+        "batch",
+        s(&inputs),
+        "-o",
+        s(&out),
+        "--method",
+        "eck-hadenfeld",
+        "--tolerance",
+        "0.05",
+    ]);
+    ok(&o);
+    let after = io::DxfDrawing::read(&written)
+        .unwrap()
+        .curves(&ReadOptions::default());
+    let (Ok(Source::Curve(cb)), Ok(Source::Curve(ca))) = (&before[0].source, &after[0].source)
+    else {
+        panic!("spline")
+    };
+    assert_eq!(ca.knots(), cb.knots());
+    assert_ne!(ca.control_points(), cb.control_points());
 }
 
 #[test]

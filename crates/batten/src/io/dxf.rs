@@ -24,7 +24,7 @@ use dxf::entities::{Entity, EntityType, LwPolyline, Spline};
 use dxf::enums::AcadVersion;
 use dxf::{Drawing, LwPolylineVertex};
 
-use super::{IoError, Location, Origin, Pick, Raw};
+use super::{IoError, Location, Origin, Pick, Raw, ReadOptions, Source, validated};
 use crate::geom::Point;
 use crate::spline::{BSplineCurve, KnotVector};
 
@@ -148,13 +148,8 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Orig
             ));
         }
     };
-    let raw_z = entity_curve(found, path)?;
-    let origin = Origin {
-        z: raw_z.1,
-        layer: Some(found.entity.common.layer.clone()),
-        name: Some(found.handle()),
-    };
-    Ok((raw_z.0, origin))
+    let (raw, z) = entity_curve(found, path)?;
+    Ok((raw, origin_of(found, z)))
 }
 
 /// One entity as points or a B-spline, with its constant z.
@@ -285,6 +280,194 @@ pub(crate) fn entity_curve(found: &Found<'_>, path: &Path) -> Result<(Raw, f64),
             Ok((Raw::Curve(curve), z))
         }
         _ => Err(err("not a curve entity".into())),
+    }
+}
+
+/// The origin of a found entity: its handle, layer and z.
+fn origin_of(found: &Found<'_>, z: f64) -> Origin {
+    Origin {
+        z,
+        layer: Some(found.entity.common.layer.clone()),
+        name: Some(found.handle()),
+    }
+}
+
+/// A whole DXF drawing, kept to write back with some curves replaced: what `batch` does
+/// with a DXF file. Every other entity, table and header variable is written back as the
+/// `dxf` crate read it; handles and layers are kept.
+#[derive(Debug)]
+pub struct DxfDrawing {
+    drawing: Drawing,
+    path: std::path::PathBuf,
+}
+
+/// One curve entity of a [`DxfDrawing`]: where it sits, and its points or B-spline (or why
+/// batten cannot take it).
+#[derive(Debug)]
+pub struct DxfCurve {
+    /// Handle (`name`), layer and z.
+    pub origin: Origin,
+    /// `LWPOLYLINE`, `POLYLINE` or `SPLINE`.
+    pub kind: &'static str,
+    /// What it holds: validated points or a B-spline; or the one-line reason it cannot be
+    /// taken (a bulge, a varying z, too few points, ...).
+    pub source: Result<Source, IoError>,
+}
+
+/// New geometry for a curve entity of a [`DxfDrawing`].
+#[derive(Clone, Copy, Debug)]
+pub enum DxfGeometry<'a> {
+    /// As many points as the entity gave (a closed entity's repeated first vertex is kept
+    /// repeated).
+    Points(&'a [Point]),
+    /// A B-spline for a `SPLINE` with control points: degree, knots, control points and
+    /// weights are replaced.
+    Curve(&'a BSplineCurve),
+}
+
+impl DxfDrawing {
+    /// Parse a drawing; `path` names it in messages.
+    ///
+    /// # Errors
+    /// [`IoError::Format`] for a file the `dxf` crate cannot read.
+    pub fn parse(bytes: &[u8], path: &Path) -> Result<DxfDrawing, IoError> {
+        Ok(DxfDrawing {
+            drawing: load(bytes, path)?,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// Read a drawing from a file.
+    ///
+    /// # Errors
+    /// [`IoError::Read`], and what [`DxfDrawing::parse`] reports.
+    pub fn read(path: &Path) -> Result<DxfDrawing, IoError> {
+        DxfDrawing::parse(&super::read_bytes(path)?, path)
+    }
+
+    /// Every curve entity (`LWPOLYLINE`, `POLYLINE` that is not a mesh, `SPLINE`) in file
+    /// order, points validated as by [`super::parse_points`] with `options`.
+    pub fn curves(&self, options: &ReadOptions) -> Vec<DxfCurve> {
+        curves(&self.drawing)
+            .iter()
+            .map(|f| {
+                let (source, z) = match entity_curve(f, &self.path) {
+                    Ok((raw, z)) => (validated(raw, &self.path, options), z),
+                    Err(e) => (Err(e), 0.0),
+                };
+                DxfCurve {
+                    origin: origin_of(f, z),
+                    kind: f.kind,
+                    source,
+                }
+            })
+            .collect()
+    }
+
+    /// Replace the geometry of the curve entity with handle `handle` (as
+    /// [`DxfCurve::origin`] names it); z, layer, handle and every other property stay.
+    ///
+    /// # Errors
+    /// [`IoError::Format`] when no curve entity has that handle, the point count differs
+    /// from what the entity gave, or a B-spline is given for anything but a `SPLINE` with
+    /// control points (or points for one).
+    pub fn replace(&mut self, handle: &str, geometry: DxfGeometry<'_>) -> Result<(), IoError> {
+        let path = self.path.clone();
+        let fail = |m: String| format_err(&path, format!("entity {handle}: {m}"));
+        let Some(e) = self
+            .drawing
+            .entities_mut()
+            .find(|e| format!("{:X}", e.common.handle.0) == handle)
+        else {
+            return Err(fail("no such entity".into()));
+        };
+        // New (x, y) for `n` vertices of which the first `given` were read (a closed
+        // entity may repeat its first vertex at the end).
+        let points_for = |n: usize, pts: &[Point]| -> Result<Vec<Point>, IoError> {
+            match n.checked_sub(pts.len()) {
+                Some(0) => Ok(pts.to_vec()),
+                Some(1) if pts.len() > 1 => {
+                    let mut v = pts.to_vec();
+                    v.push(pts[0]);
+                    Ok(v)
+                }
+                _ => Err(fail(format!(
+                    "{} points for an entity of {n} vertices",
+                    pts.len()
+                ))),
+            }
+        };
+        match (&mut e.specific, geometry) {
+            (EntityType::LwPolyline(lw), DxfGeometry::Points(pts)) => {
+                let new = points_for(lw.vertices.len(), pts)?;
+                for (v, p) in lw.vertices.iter_mut().zip(new) {
+                    (v.x, v.y) = (p.x, p.y);
+                }
+            }
+            (EntityType::Polyline(pl), DxfGeometry::Points(pts)) => {
+                let n = pl
+                    .vertices()
+                    .filter(|v| v.flags & VERTEX_FRAME == 0)
+                    .count();
+                let new = points_for(n, pts)?;
+                let on_curve = pl.vertices_mut().filter(|v| v.flags & VERTEX_FRAME == 0);
+                for (v, p) in on_curve.zip(new) {
+                    (v.location.x, v.location.y) = (p.x, p.y);
+                }
+            }
+            (EntityType::Spline(sp), DxfGeometry::Points(pts)) if sp.control_points.is_empty() => {
+                let new = points_for(sp.fit_points.len(), pts)?;
+                for (v, p) in sp.fit_points.iter_mut().zip(new) {
+                    (v.x, v.y) = (p.x, p.y);
+                }
+            }
+            (EntityType::Spline(sp), DxfGeometry::Curve(c)) if !sp.control_points.is_empty() => {
+                let z = sp.control_points.first().map_or(0.0, |p| p.z);
+                sp.degree_of_curve = i32::try_from(c.degree())
+                    .map_err(|_| fail("the degree does not fit a DXF integer".into()))?;
+                sp.knot_values = c.knots().as_slice().to_vec();
+                sp.control_points = c
+                    .control_points()
+                    .iter()
+                    .map(|p| dxf::Point::new(p.x, p.y, z))
+                    .collect();
+                sp.weight_values = c.weights().map(<[f64]>::to_vec).unwrap_or_default();
+                sp.set_is_rational(c.weights().is_some());
+            }
+            (EntityType::Spline(_), DxfGeometry::Points(_)) => {
+                return Err(fail(
+                    "a SPLINE with control points takes a B-spline, not points".into(),
+                ));
+            }
+            (_, DxfGeometry::Curve(_)) => {
+                return Err(fail(
+                    "only a SPLINE with control points takes a B-spline".into(),
+                ));
+            }
+            _ => return Err(fail("not a curve entity".into())),
+        }
+        Ok(())
+    }
+
+    /// The drawing as ASCII DXF, in the version it was read in, or R2000 when that version
+    /// cannot hold its LWPOLYLINE or SPLINE entities (a file without a header reads as R12,
+    /// and the `dxf` crate leaves out of a file what its version cannot hold).
+    ///
+    /// # Errors
+    /// [`IoError::Format`] when the `dxf` crate cannot encode it.
+    pub fn to_bytes(&self) -> Result<Vec<u8>, IoError> {
+        let modern = self.drawing.entities().any(|e| {
+            matches!(
+                e.specific,
+                EntityType::LwPolyline(_) | EntityType::Spline(_)
+            )
+        });
+        if modern && self.drawing.header.version < AcadVersion::R2000 {
+            let mut d = self.drawing.clone();
+            d.header.version = AcadVersion::R2000;
+            return save(&d, &self.path);
+        }
+        save(&self.drawing, &self.path)
     }
 }
 

@@ -57,6 +57,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+pub use dxf::{DxfCurve, DxfDrawing, DxfGeometry};
 pub use error::{IoError, Location};
 pub use text::format_f64;
 
@@ -442,7 +443,15 @@ pub fn parse_input(
         Format::Iges => iges::parse(bytes, path, pick)?,
         Format::Svg => svg::parse(bytes, path, pick)?,
     };
-    let source = match raw {
+    Ok(Input {
+        source: validated(raw, path, options)?,
+        origin,
+    })
+}
+
+/// Validate what a format reader gave: points as [`parse_points`] does, a B-spline as it is.
+fn validated(raw: Raw, path: &Path, options: &ReadOptions) -> Result<Source, IoError> {
+    Ok(match raw {
         Raw::Points {
             points,
             lines,
@@ -453,8 +462,7 @@ pub fn parse_input(
             lines,
         }),
         Raw::Curve(c) => Source::Curve(c),
-    };
-    Ok(Input { source, origin })
+    })
 }
 
 /// Read any input file (format by extension, or `format` when given).
