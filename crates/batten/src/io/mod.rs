@@ -1,7 +1,8 @@
-//! Reading and writing point lists and curves (CSV/whitespace text and JSON).
+//! Reading and writing point lists and curves: CSV/whitespace text, JSON, DXF, IGES, SVG.
 //!
 //! The format follows the file name's extension ([`Format::from_path`]): `.csv` and `.txt`
-//! are text (one `x,y` per line, see [Text format](#text-format)), `.json` is JSON.
+//! are text (one `x,y` per line, see [Text format](#text-format)), `.json` is JSON, `.dxf`,
+//! `.igs`/`.iges` and `.svg` the CAD formats (see [Other formats](#other-formats)).
 //!
 //! - [`read_points`] reads a point list and validates it into a [`PointSeq`], keeping the
 //!   1-based line of every point so that every error names the file and the line:
@@ -11,7 +12,26 @@
 //!   and numbers in their shortest exact form: what is written reads back bit for bit.
 //! - [`ensure_distinct`] refuses an output path that is the input file.
 //!
+//! - [`parse_input`] / [`read_input`] read any format from bytes (standard input) or a file,
+//!   picking one curve of a file that holds several ([`Pick`]), into points or a B-spline
+//!   ([`Source`]) and where it sat ([`Origin`]: z, layer, name), so that
+//!   [`format_points`] and [`format_curve`] can write the result back alike.
+//! - [`DxfDrawing`] keeps a whole DXF drawing to write it back with several curves replaced.
+//!
 //! Nothing here prints; every failure is an [`IoError`].
+//!
+//! # Other formats
+//!
+//! | format | read | written by [`format_points`] | written by [`format_curve`] |
+//! |---|---|---|---|
+//! | DXF (`dxf` crate) | `LWPOLYLINE`, `POLYLINE`, `SPLINE` (control points: a B-spline; fit points only: points) | `LWPOLYLINE` | `SPLINE` |
+//! | IGES (5.3, fixed form) | entity 126 (B-spline), 106 (copious data) | entity 106 | entity 126 |
+//! | SVG (`roxmltree`) | `<path>` (lines: points; Béziers: a cubic B-spline), `<polyline>`, `<polygon>` | a path of the C² cubic through the points | a path of Bézier segments |
+//!
+//! The curve must be planar (constant z; the z is kept in [`Origin`] and written back) and
+//! untransformed; each module's documentation (`io/dxf.rs`, `io/iges.rs`, `io/svg/`) says
+//! exactly what it takes and refuses. IGES, SVG, text and JSON read back bit for bit; DXF
+//! within the 12 decimal places the `dxf` crate writes.
 //!
 //! # Text format
 //!
