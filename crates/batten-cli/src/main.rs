@@ -65,7 +65,7 @@ enum Command {
 /// Arguments of `batten analyze`.
 #[derive(Debug, Args)]
 struct AnalyzeArgs {
-    /// Point file (.csv, .txt or .json)
+    /// Point file (.csv, .txt, .json, .dxf, .igs, .svg; `-` reads standard input)
     #[arg(value_name = "INPUT")]
     input: PathBuf,
     /// Print a JSON object instead of a table
@@ -74,6 +74,8 @@ struct AnalyzeArgs {
     /// The points form a closed curve (the last connects to the first; do not repeat it)
     #[arg(long)]
     closed: bool,
+    #[command(flatten)]
+    pick: formats::PickArgs,
 }
 
 /// Arguments of `batten fair`.

@@ -600,3 +600,29 @@ fn bad_cad_files_are_one_line_exit_2_and_nothing_written() {
         assert!(!out.exists() && !rep.exists(), "{name}");
     }
 }
+
+#[test]
+fn analyze_reads_stdin_and_picks_a_dxf_entity() {
+    let o = batten_stdin(&["analyze", "-", "--json"], sine_csv().as_bytes());
+    ok(&o);
+    let from_pipe: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let o = batten(&["analyze", s(&noisy_sine(dir.path())), "--json"]);
+    ok(&o);
+    let from_file: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(from_pipe, from_file);
+
+    let dxf = two_layer_dxf(dir.path());
+    let o = batten(&["analyze", s(&dxf), "--layer", "DECK", "--json"]);
+    ok(&o);
+    let m: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(m["points"], 30);
+    refused(
+        &batten(&["analyze", s(&dxf)]),
+        &["two.dxf: 2 curve entities"],
+    );
+    refused(
+        &batten(&["analyze", s(&dxf), "--sample", "3"]),
+        &["--sample applies to an SVG input"],
+    );
+}
