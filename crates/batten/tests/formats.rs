@@ -163,3 +163,66 @@ proptest! {
         }
     }
 }
+
+/// A valid file of each format, to mutate.
+fn samples() -> Vec<(Format, Vec<u8>)> {
+    let pts: Vec<Point> = (0..8)
+        .map(|i| Point::new(f64::from(i), f64::from(i * i % 5)))
+        .collect();
+    let c = BSplineCurve::try_new(
+        3,
+        KnotVector::try_new(vec![0., 0., 0., 0., 0.5, 1., 1., 1., 1.]).unwrap(),
+        pts[..5].to_vec(),
+        Some(vec![1.0, 0.5, 2.0, 1.0, 1.0]),
+    )
+    .unwrap();
+    let o = Origin::default();
+    let p = Path::new("o");
+    let mut v = Vec::new();
+    for f in [Format::Iges, Format::Svg, Format::Dxf] {
+        v.push((f, io::format_points(f, p, &pts, false, None, &o).unwrap()));
+    }
+    v.push((
+        Format::Iges,
+        io::format_curve(Format::Iges, p, &c, false, &o).unwrap(),
+    ));
+    v.push((
+        Format::Dxf,
+        io::format_curve(Format::Dxf, p, &c, false, &o).unwrap(),
+    ));
+    v
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// Damaged files are an error or a curve, never a panic: bytes overwritten, cut off or
+    /// spliced into a valid file of each format.
+    #[test]
+    fn damaged_files_never_panic(
+        which in 0usize..5,
+        edits in proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8),
+        cut in any::<prop::sample::Index>(),
+        truncate in any::<bool>(),
+    ) {
+        let (format, mut bytes) = samples().swap_remove(which);
+        for (at, b) in edits {
+            let i = at.index(bytes.len());
+            // Mostly characters the formats use, so the parsers get past their first check.
+            bytes[i] = match b % 4 {
+                0 => b"0123456789"[usize::from(b) % 10],
+                1 => b",;.-+ED\n H"[usize::from(b) % 10],
+                _ => b,
+            };
+        }
+        if truncate {
+            bytes.truncate(cut.index(bytes.len() + 1));
+        }
+        let r = io::parse_input(&bytes, format, Path::new("o"), &ReadOptions::default(), &Pick::default());
+        if let Err(e) = r {
+            let m = e.to_string();
+            prop_assert!(m.starts_with("o"), "{}", m);
+            prop_assert!(!m.contains('\n'), "{}", m);
+        }
+    }
+}

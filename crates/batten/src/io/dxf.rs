@@ -24,6 +24,7 @@ use dxf::entities::{Entity, EntityType, LwPolyline, Spline};
 use dxf::enums::AcadVersion;
 use dxf::{Drawing, LwPolylineVertex};
 
+use super::error::one_line;
 use super::{IoError, Location, Origin, Pick, Raw, ReadOptions, Source, validated};
 use crate::geom::Point;
 use crate::spline::{BSplineCurve, KnotVector};
@@ -67,9 +68,34 @@ impl Found<'_> {
 }
 
 /// Load a drawing from bytes.
+///
+/// The `dxf` crate (0.6) panics on some malformed values instead of returning an error (a
+/// date such as `$TDCREATE` far out of range overflows chrono's `TimeDelta`); the panic is
+/// caught here and becomes the same one-line error as any other malformed file. (The
+/// default panic hook still prints the crate's message to stderr first.)
 pub(crate) fn load(bytes: &[u8], path: &Path) -> Result<Drawing, IoError> {
-    let mut reader = bytes;
-    Drawing::load(&mut reader).map_err(|e| format_err(path, format!("malformed DXF: {e}")))
+    let loaded = std::panic::catch_unwind(|| {
+        let mut reader = bytes;
+        Drawing::load(&mut reader)
+    });
+    match loaded {
+        Ok(Ok(d)) => Ok(d),
+        Ok(Err(e)) => Err(format_err(
+            path,
+            format!("malformed DXF: {}", one_line(&e.to_string())),
+        )),
+        Err(payload) => {
+            let why = payload
+                .downcast_ref::<&str>()
+                .map(|s| (*s).to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown cause".to_string());
+            Err(format_err(
+                path,
+                format!("malformed DXF: a value out of range ({})", one_line(&why)),
+            ))
+        }
+    }
 }
 
 /// The curve entities of a drawing, in file order.
@@ -714,5 +740,18 @@ mod tests {
         )
         .unwrap_err();
         assert_eq!(e, "d.dxf: no LWPOLYLINE, POLYLINE or SPLINE entity");
+    }
+
+    /// Regression: the `dxf` crate panics on a date out of chrono's range (found by the
+    /// damaged-file property test); batten reports it as a malformed file.
+    #[test]
+    fn a_date_out_of_range_is_an_error_not_a_panic() {
+        let text = "  0\nSECTION\n  2\nHEADER\n  9\n$TDCREATE\n 40\n1e300\n  0\nENDSEC\n  0\nEOF\n";
+        let e = read(text.as_bytes(), &Pick::default()).unwrap_err();
+        assert!(
+            e.starts_with("d.dxf: malformed DXF: a value out of range ("),
+            "{e}"
+        );
+        assert!(!e.contains('\n'), "{e}");
     }
 }

@@ -236,3 +236,19 @@ impl std::fmt::Display for Location {
         }
     }
 }
+
+/// A message from another crate on one line: control characters (a newline it quotes from
+/// the file) written as escapes.
+pub(crate) fn one_line(message: &str) -> String {
+    message
+        .chars()
+        .flat_map(|c| {
+            let escaped: Vec<char> = if c.is_control() {
+                c.escape_default().collect()
+            } else {
+                vec![c]
+            };
+            escaped
+        })
+        .collect()
+}

@@ -30,6 +30,7 @@ use std::path::Path;
 
 use roxmltree::{Document, Node};
 
+use super::error::one_line;
 use super::{IoError, Location, Origin, Pick, Raw, format_f64};
 use crate::geom::{BBox, Point};
 use crate::spline::{BSplineCurve, KnotVector};
@@ -78,7 +79,7 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Orig
         format_err(
             path,
             Location::LineColumn(p.row as usize, p.col as usize),
-            format!("malformed XML: {e}"),
+            format!("malformed XML: {}", one_line(&e.to_string())),
         )
     })?;
     let root = doc.root_element();
