@@ -529,15 +529,17 @@ pub(crate) fn format_points(
     origin: &Origin,
     path: &Path,
 ) -> Result<Vec<u8>, IoError> {
-    let mut lw = LwPolyline::default();
-    lw.vertices = points
-        .iter()
-        .map(|p| LwPolylineVertex {
-            x: p.x,
-            y: p.y,
-            ..Default::default()
-        })
-        .collect();
+    let mut lw = LwPolyline {
+        vertices: points
+            .iter()
+            .map(|p| LwPolylineVertex {
+                x: p.x,
+                y: p.y,
+                ..Default::default()
+            })
+            .collect(),
+        ..Default::default()
+    };
     lw.set_is_closed(closed);
     let mut entity = Entity::new(EntityType::LwPolyline(lw));
     entity.common.elevation = origin.z;
@@ -551,20 +553,22 @@ pub(crate) fn format_curve(
     origin: &Origin,
     path: &Path,
 ) -> Result<Vec<u8>, IoError> {
-    let mut sp = Spline::default();
-    sp.degree_of_curve = i32::try_from(curve.degree())
-        .map_err(|_| format_err(path, "the degree does not fit a DXF integer"))?;
-    sp.knot_values = curve.knots().as_slice().to_vec();
-    sp.control_points = curve
-        .control_points()
-        .iter()
-        .map(|p| dxf::Point::new(p.x, p.y, origin.z))
-        .collect();
-    sp.weight_values = curve.weights().map(<[f64]>::to_vec).unwrap_or_default();
-    sp.flags = SPLINE_PLANAR;
+    let mut sp = Spline {
+        degree_of_curve: i32::try_from(curve.degree())
+            .map_err(|_| format_err(path, "the degree does not fit a DXF integer"))?,
+        knot_values: curve.knots().as_slice().to_vec(),
+        control_points: curve
+            .control_points()
+            .iter()
+            .map(|p| dxf::Point::new(p.x, p.y, origin.z))
+            .collect(),
+        weight_values: curve.weights().map(<[f64]>::to_vec).unwrap_or_default(),
+        flags: SPLINE_PLANAR,
+        normal: dxf::Vector::z_axis(),
+        ..Default::default()
+    };
     sp.set_is_rational(curve.weights().is_some());
     sp.set_is_closed(closed);
-    sp.normal = dxf::Vector::z_axis();
     save(
         &drawing_with(Entity::new(EntityType::Spline(sp)), origin),
         path,
@@ -648,25 +652,29 @@ mod tests {
         let mut d = Drawing::new();
         d.header.version = AcadVersion::R2000;
         for (layer, z) in [("A", 0.0), ("B", 1.0)] {
-            let mut lw = LwPolyline::default();
-            lw.vertices = pts()
-                .iter()
-                .map(|p| LwPolylineVertex {
-                    x: p.x,
-                    y: p.y,
-                    ..Default::default()
-                })
-                .collect();
+            let lw = LwPolyline {
+                vertices: pts()
+                    .iter()
+                    .map(|p| LwPolylineVertex {
+                        x: p.x,
+                        y: p.y,
+                        ..Default::default()
+                    })
+                    .collect(),
+                ..Default::default()
+            };
             let mut e = Entity::new(EntityType::LwPolyline(lw));
             e.common.layer = layer.into();
             e.common.elevation = z;
             d.add_entity(e);
         }
-        let mut sp = Spline::default();
-        sp.degree_of_curve = 3;
-        sp.fit_points = (0..5)
-            .map(|i| dxf::Point::new(f64::from(i), 0.0, f64::from(i)))
-            .collect();
+        let sp = Spline {
+            degree_of_curve: 3,
+            fit_points: (0..5)
+                .map(|i| dxf::Point::new(f64::from(i), 0.0, f64::from(i)))
+                .collect(),
+            ..Default::default()
+        };
         let mut e = Entity::new(EntityType::Spline(sp));
         e.common.layer = "C".into();
         d.add_entity(e);
@@ -707,17 +715,19 @@ mod tests {
     fn bulges_and_garbage_are_refused() {
         let mut d = Drawing::new();
         d.header.version = AcadVersion::R2000;
-        let mut lw = LwPolyline::default();
-        lw.vertices = pts()
-            .iter()
-            .enumerate()
-            .map(|(i, p)| LwPolylineVertex {
-                x: p.x,
-                y: p.y,
-                bulge: if i == 2 { 0.5 } else { 0.0 },
-                ..Default::default()
-            })
-            .collect();
+        let lw = LwPolyline {
+            vertices: pts()
+                .iter()
+                .enumerate()
+                .map(|(i, p)| LwPolylineVertex {
+                    x: p.x,
+                    y: p.y,
+                    bulge: if i == 2 { 0.5 } else { 0.0 },
+                    ..Default::default()
+                })
+                .collect(),
+            ..Default::default()
+        };
         d.add_entity(Entity::new(EntityType::LwPolyline(lw)));
         let mut out = Vec::new();
         d.save(&mut out).unwrap();
