@@ -226,3 +226,61 @@ proptest! {
         }
     }
 }
+
+fn dxf_fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/dxf")
+        .join(name)
+}
+
+fn pairs(v: &serde_json::Value) -> Vec<Point> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|p| Point::new(p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
+        .collect()
+}
+
+fn floats(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
+}
+
+/// Every entity of a DXF file written by ezdxf (`fixtures/make_dxf_fixtures.py`), picked by
+/// its handle, reads as what ezdxf was given, bit for bit; the 3-D polyline is refused.
+#[test]
+fn ezdxf_entities_read_as_ezdxf_was_given() {
+    let text = std::fs::read_to_string(dxf_fixture("expected.json")).unwrap();
+    let exp: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let path = dxf_fixture("ezdxf_r2010.dxf");
+    let entities = exp["entities"].as_object().unwrap();
+    assert_eq!(entities.len(), 6);
+    for (handle, e) in entities {
+        let pick = Pick::default().with_entity(Some(handle.clone()));
+        let r = io::read_input(&path, None, &ReadOptions::default(), &pick);
+        if e.get("refused").is_some() {
+            let m = r.unwrap_err().to_string();
+            assert!(m.contains(&format!("POLYLINE {handle} on layer SPACE: z varies")), "{m}");
+            continue;
+        }
+        let input = r.unwrap();
+        assert_eq!(input.origin.name.as_deref(), Some(handle.as_str()));
+        assert_eq!(input.origin.layer.as_deref(), e["layer"].as_str());
+        assert_eq!(input.origin.z, e["z"].as_f64().unwrap(), "{handle}");
+        match input.source {
+            Source::Points(d) => {
+                assert_eq!(d.seq.points(), &pairs(&e["points"])[..], "{handle}");
+                assert_eq!(d.seq.is_closed(), e["closed"].as_bool().unwrap(), "{handle}");
+            }
+            Source::Curve(c) => {
+                assert_eq!(c.degree() as u64, e["degree"].as_u64().unwrap());
+                assert_eq!(c.knots().as_slice(), &floats(&e["knots"])[..]);
+                assert_eq!(c.control_points(), &pairs(&e["control_points"])[..]);
+                assert_eq!(c.weights().unwrap(), &floats(&e["weights"])[..]);
+            }
+        }
+    }
+}
