@@ -48,7 +48,7 @@ enum Command {
     /// Fair the points and write them (same count and order) to OUTPUT
     Fair(FairArgs),
     /// List the fairing methods, their descriptions and parameters
-    Methods,
+    Methods(methods::MethodsArgs),
     /// Run several methods on the same input and tabulate the results (Han et al.'s Table 1)
     Compare(CompareArgs),
     /// Draw the curvature comb, κ(s), ρ(s) or x–c plot as SVG, the faired curve over the input
@@ -159,7 +159,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Analyze(a) => analyze::run(&a),
         Command::Fair(a) => fair_cmd::run(&a),
-        Command::Methods => methods::run(),
+        Command::Methods(a) => methods::run(&a),
         Command::Compare(a) => compare::run(&a),
         Command::Plot(a) => plot::run(&a),
         Command::Report(a) => report::run(&a),

@@ -11,6 +11,7 @@
 //! in [`methods`].
 
 pub mod cali;
+mod catalogue;
 pub mod eck_hadenfeld;
 pub mod han;
 pub mod kjellander;
@@ -25,6 +26,7 @@ pub mod smoothing;
 use std::time::Instant;
 
 pub use cali::Cali;
+pub use catalogue::{MethodInfo, ParamInfo, ParamType, catalogue};
 pub use eck_hadenfeld::EckHadenfeld;
 pub use han::Han;
 pub use kjellander::{
