@@ -42,15 +42,17 @@ impl BSpline {
         control_points: &Bound<'_, PyAny>,
         weights: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<BSpline> {
+        // Every problem with the arguments is bad input (a ValueError), as a malformed curve
+        // file is for the CLI.
         let knots = KnotVector::try_new(convert::vector(knots, "knots")?)
-            .map_err(|e| errors::library("", &e))?;
+            .map_err(|e| errors::value(e.to_string()))?;
         let control_points = convert::points(control_points, "control_points")?;
         let weights = match weights.filter(|w| !w.is_none()) {
             Some(w) => Some(convert::vector(w, "weights")?),
             None => None,
         };
         let curve = BSplineCurve::try_new(degree, knots, control_points, weights)
-            .map_err(|e| errors::library("", &e))?;
+            .map_err(|e| errors::value(e.to_string()))?;
         Ok(BSpline { curve })
     }
 

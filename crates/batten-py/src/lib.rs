@@ -35,6 +35,7 @@ use crate::result::FairResult;
 #[pyfunction]
 #[pyo3(signature = (points, method = None, tolerance = None, fix_ends = None,
                     max_iterations = None, closed = false, **params))]
+#[allow(clippy::too_many_arguments)] // the Python signature, keyword by keyword
 fn fair(
     py: Python<'_>,
     points: &Bound<'_, PyAny>,
@@ -57,6 +58,7 @@ fn fair(
 #[pyfunction]
 #[pyo3(signature = (curves, method = None, tolerance = None, fix_ends = None,
                     max_iterations = None, closed = false, **params))]
+#[allow(clippy::too_many_arguments)] // the Python signature, keyword by keyword
 fn fair_many(
     py: Python<'_>,
     curves: &Bound<'_, PyAny>,
@@ -91,6 +93,37 @@ fn fair_many(
             )),
         })
         .collect()
+}
+
+/// For the bench (`bench/python_speed.py`): the library's own time per call, in seconds, of
+/// fairing the same input `repeat` times with these options, with no conversion to or from
+/// Python inside the loop. `batten.fair`'s time minus this is the binding's overhead.
+#[pyfunction]
+#[pyo3(signature = (points, repeat, method = None, tolerance = None, fix_ends = None,
+                    max_iterations = None, closed = false, **params))]
+#[allow(clippy::too_many_arguments)] // the Python signature, keyword by keyword
+fn _rust_seconds_per_call(
+    py: Python<'_>,
+    points: &Bound<'_, PyAny>,
+    repeat: usize,
+    method: Option<&str>,
+    tolerance: Option<&Bound<'_, PyAny>>,
+    fix_ends: Option<&Bound<'_, PyAny>>,
+    max_iterations: Option<&Bound<'_, PyAny>>,
+    closed: bool,
+    params: Option<&Bound<'_, PyDict>>,
+) -> PyResult<f64> {
+    let request = Request::new(method, tolerance, fix_ends, max_iterations, closed, params)?;
+    let input = request.input(points, closed)?;
+    let repeat = repeat.max(1);
+    py.detach(|| {
+        let start = std::time::Instant::now();
+        for _ in 0..repeat {
+            std::hint::black_box(request.run(std::hint::black_box(&input)))
+                .map_err(|e| request.error(&e))?;
+        }
+        Ok(start.elapsed().as_secs_f64() / repeat as f64)
+    })
 }
 
 /// The fairness metrics of the curve through the points: `batten analyze --json` as a dict.
@@ -133,5 +166,6 @@ fn _batten(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     m.add_function(wrap_pyfunction!(default_method, m)?)?;
     m.add_function(wrap_pyfunction!(result::_restore_fair_result, m)?)?;
+    m.add_function(wrap_pyfunction!(_rust_seconds_per_call, m)?)?;
     Ok(())
 }

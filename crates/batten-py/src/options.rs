@@ -95,6 +95,19 @@ impl Request {
                     "closed=True applies to points: a B-spline curve is faired as it is",
                 ));
             }
+            // Checked before the run, as `batten fair` checks a curve file.
+            if !self.method.run_curve_supported() {
+                let takes: Vec<&str> = fair::methods()
+                    .iter()
+                    .filter(|m| m.run_curve_supported())
+                    .map(|m| m.name())
+                    .collect();
+                return Err(errors::value(format!(
+                    "method {} takes points, not a B-spline curve (B-spline input: {})",
+                    self.method.name(),
+                    takes.join(", ")
+                )));
+            }
             return Ok(Input::Curve(b.get().curve().clone()));
         }
         let points = convert::points(obj, "points")?;
