@@ -75,6 +75,10 @@ def main() -> None:
         rows.append((f"  batten.fair + .report, overhead", f"{(py_report - rust) * 1e6:.1f} µs",
                      f"{py_report * 1e6:.0f} µs per call"))
 
+    t_an = best(lambda: [batten.analyze(one) for _ in range(calls)], 5) / calls
+    rows.append(("batten.analyze, same curve (the metrics every report measures, before and after)",
+                 f"{t_an * 1e6:.0f} µs", ""))
+
     if not args.no_dask:
         import dask
         import dask.bag as db
