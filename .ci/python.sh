@@ -7,6 +7,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 export CARGO_TERM_COLOR=never
 start=$(date +%s)
+last=$start
+# Seconds since the previous step and since the start, for CI's time budget.
+took() { local now; now=$(date +%s); echo "   ($1: $((now - last)) s, $((now - start)) s in all)"; last=$now; }
 
 echo "== python: interpreter, venv and headers"
 has_python() {
@@ -27,17 +30,21 @@ python3 -m venv "$work/venv"
 py="$work/venv/bin/python"
 "$py" -m pip install --quiet --upgrade pip
 "$py" -m pip install --quiet "maturin>=1.9,<2" numpy pytest "dask[bag,dataframe,distributed]" pandas
+took "venv and PyPI packages"
 
 echo "== batten-py: cargo fmt --check, clippy -D warnings (outside the workspace)"
 cargo fmt --manifest-path crates/batten-py/Cargo.toml -- --check
 PYO3_PYTHON="$py" cargo clippy --manifest-path crates/batten-py/Cargo.toml --all-targets -- -D warnings
+took "fmt and clippy"
 
 echo "== pip install ./crates/batten-py (maturin builds the extension)"
 "$py" -m pip install --quiet ./crates/batten-py
 "$py" -c 'import batten; print("batten", batten.__version__, "from", batten.__file__)'
+took "pip install (maturin, release build)"
 
 echo "== pytest crates/batten-py/tests (against the CLI for parity)"
 cargo build --release -p batten-cli
+took "the CLI, release (already built by .ci/run)"
 # From a directory outside the source tree: the tests import the installed package.
 (cd "$work" && BATTEN_CLI="$OLDPWD/target/release/batten" "$py" -m pytest \
   "$OLDPWD/crates/batten-py/tests" -p no:cacheprovider -rs --junitxml "$work/junit.xml")
@@ -52,4 +59,5 @@ bad = int(suite.get("failures")) + int(suite.get("errors"))
 print(f"pytest: {tests} tests, {skipped} skipped, {bad} failed")
 sys.exit(0 if tests >= 50 and skipped == 0 and bad == 0 else 1)
 PY
+took "pytest"
 echo "python: ok in $(($(date +%s) - start)) s"

@@ -278,8 +278,11 @@ def test_bspline_errors():
     b = bspline_of(noisy_sine(n=30))
     with pytest.raises(ValueError, match=r"^method mst takes points, not a B-spline curve \(B-spline input: salvi, eck-hadenfeld\)$"):
         batten.fair(b, method="mst")
-    with pytest.raises(ValueError, match="^closed=True applies to points"):
+    # A method without closed curves refuses closed=True first, as an option (the CLI's check).
+    with pytest.raises(ValueError, match="^method salvi does not support closed curves$"):
         batten.fair(b, method="salvi", closed=True)
+    with pytest.raises(ValueError, match="^closed=True applies to points"):
+        batten.fair(b, method="eck-hadenfeld", closed=True)
 
 
 def test_results_pickle():
