@@ -12,21 +12,28 @@ last=$start
 took() { local now; now=$(date +%s); echo "   ($1: $((now - last)) s, $((now - start)) s in all)"; last=$now; }
 
 echo "== python: interpreter, venv and headers"
-has_python() {
-  command -v python3 >/dev/null 2>&1 &&
-    python3 -c 'import ensurepip, venv, os, sys, sysconfig
+# A CPython that can make a venv (ensurepip) and build an extension (Python.h): the machine's
+# python3, else Debian's, installed here when missing (a python3 first on PATH that lacks them,
+# a pyenv build say, is passed over for /usr/bin/python3).
+usable() {
+  command -v "$1" >/dev/null 2>&1 &&
+    "$1" -c 'import ensurepip, venv, os, sys, sysconfig
 sys.exit(not os.path.exists(os.path.join(sysconfig.get_paths()["include"], "Python.h")))'
 }
-if ! has_python; then
-  apt-get update
-  DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends \
-    python3 python3-venv python3-dev python3-pip
+python=python3
+if ! usable "$python"; then
+  python=/usr/bin/python3
+  if ! usable "$python"; then
+    apt-get update
+    DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends \
+      python3 python3-venv python3-dev python3-pip
+  fi
 fi
-python3 --version
+"$python" --version
 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-python3 -m venv "$work/venv"
+"$python" -m venv "$work/venv"
 py="$work/venv/bin/python"
 "$py" -m pip install --quiet --upgrade pip
 "$py" -m pip install --quiet "maturin>=1.9,<2" numpy pytest "dask[bag,dataframe,distributed]" pandas
