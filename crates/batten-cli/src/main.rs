@@ -27,6 +27,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use batten::fair::EndFix;
+use clap::error::ErrorKind;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 /// Fair planar curves: measure the curvature of the curve through a list of points, move the
@@ -49,7 +50,7 @@ enum Command {
     /// Fair the points and write them (same count and order) to OUTPUT
     Fair(FairArgs),
     /// List the fairing methods, their descriptions and parameters
-    Methods,
+    Methods(methods::MethodsArgs),
     /// Run several methods on the same input and tabulate the results (Han et al.'s Table 1)
     Compare(CompareArgs),
     /// Draw the curvature comb, κ(s), ρ(s) or x–c plot as SVG, the faired curve over the input
@@ -162,11 +163,27 @@ struct CompareArgs {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // A bad option value (`--tolerance -1`): one line, as for every other usage error;
+        // clap's own rendering adds a blank line and a "try '--help'" footer.
+        Err(e)
+            if matches!(
+                e.kind(),
+                ErrorKind::ValueValidation | ErrorKind::InvalidValue
+            ) =>
+        {
+            let text = e.render().to_string();
+            let first = text.lines().next().unwrap_or_default();
+            output::error_line(first.strip_prefix("error: ").unwrap_or(first));
+            return ExitCode::from(2);
+        }
+        Err(e) => e.exit(),
+    };
     let result = match cli.command {
         Command::Analyze(a) => analyze::run(&a),
         Command::Fair(a) => fair_cmd::run(&a),
-        Command::Methods => methods::run(),
+        Command::Methods(a) => methods::run(&a),
         Command::Compare(a) => compare::run(&a),
         Command::Plot(a) => plot::run(&a),
         Command::Report(a) => report::run(&a),

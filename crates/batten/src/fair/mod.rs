@@ -12,6 +12,7 @@
 
 pub mod band;
 pub mod cali;
+mod catalogue;
 pub mod eck_hadenfeld;
 pub mod han;
 pub mod kjellander;
@@ -27,6 +28,7 @@ use std::time::Instant;
 
 pub use band::Band;
 pub use cali::Cali;
+pub use catalogue::{MethodInfo, ParamInfo, ParamType, catalogue};
 pub use eck_hadenfeld::EckHadenfeld;
 pub use han::Han;
 pub use kjellander::{
