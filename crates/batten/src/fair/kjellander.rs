@@ -1283,6 +1283,14 @@ pub struct Poliakoff;
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Energy;
 
+/// Parameters in data units of `kjellander` and their power of length: the jumps of the
+/// uniform spline's third derivative are lengths.
+const UNIFORM_LENGTH_PARAMS: &[(&str, i32)] = &[("epsilon", 1), ("initial_max_jump", 1)];
+
+/// Parameters in data units of `poliakoff` and `energy`: on the chord-length spline the
+/// third derivative has the unit 1/length².
+const CHORD_LENGTH_PARAMS: &[(&str, i32)] = &[("epsilon", -2), ("initial_max_jump", -2)];
+
 impl FairMethod for Kjellander {
     fn name(&self) -> &'static str {
         "kjellander"
@@ -1298,6 +1306,22 @@ impl FairMethod for Kjellander {
 
     fn supports_closed(&self) -> bool {
         true
+    }
+
+    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
+        Ok(super::guard::length_params_at_scale(
+            options,
+            UNIFORM_LENGTH_PARAMS,
+            s,
+        ))
+    }
+
+    fn report_params_at_scale(
+        &self,
+        parameters: &mut serde_json::Map<String, serde_json::Value>,
+        s: f64,
+    ) {
+        super::guard::report_length_params(parameters, UNIFORM_LENGTH_PARAMS, s);
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {
@@ -1324,6 +1348,22 @@ impl FairMethod for Poliakoff {
 
     fn supports_closed(&self) -> bool {
         true
+    }
+
+    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
+        Ok(super::guard::length_params_at_scale(
+            options,
+            CHORD_LENGTH_PARAMS,
+            s,
+        ))
+    }
+
+    fn report_params_at_scale(
+        &self,
+        parameters: &mut serde_json::Map<String, serde_json::Value>,
+        s: f64,
+    ) {
+        super::guard::report_length_params(parameters, CHORD_LENGTH_PARAMS, s);
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {
@@ -1355,6 +1395,22 @@ impl FairMethod for Energy {
 
     fn supports_closed(&self) -> bool {
         true
+    }
+
+    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
+        Ok(super::guard::length_params_at_scale(
+            options,
+            CHORD_LENGTH_PARAMS,
+            s,
+        ))
+    }
+
+    fn report_params_at_scale(
+        &self,
+        parameters: &mut serde_json::Map<String, serde_json::Value>,
+        s: f64,
+    ) {
+        super::guard::report_length_params(parameters, CHORD_LENGTH_PARAMS, s);
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {

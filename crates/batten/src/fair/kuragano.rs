@@ -1620,6 +1620,9 @@ impl Kuragano {
     }
 }
 
+/// Parameters in data units and their power of length.
+const LENGTH_PARAMS: &[(&str, i32)] = &[("rho_max", 1), ("arc_length", 1)];
+
 impl FairMethod for Kuragano {
     fn name(&self) -> &'static str {
         "kuragano"
@@ -1636,6 +1639,22 @@ impl FairMethod for Kuragano {
 
     fn supports_closed(&self) -> bool {
         false
+    }
+
+    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
+        Ok(super::guard::length_params_at_scale(
+            options,
+            LENGTH_PARAMS,
+            s,
+        ))
+    }
+
+    fn report_params_at_scale(
+        &self,
+        parameters: &mut serde_json::Map<String, serde_json::Value>,
+        s: f64,
+    ) {
+        super::guard::report_length_params(parameters, LENGTH_PARAMS, s);
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {

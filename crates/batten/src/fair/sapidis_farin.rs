@@ -437,6 +437,11 @@ pub(crate) fn interpolate_closed(points: &[Point]) -> Result<(BSplineCurve, Vec<
 /// (four spans) must be shorter than the period.
 pub const MIN_CLOSED_POINTS: usize = 6;
 
+/// Parameters in data units and their power of length: the B-spline's third-derivative
+/// jumps (on the averaging knots of the chord-length parameters, as the method measures them)
+/// scale as a length.
+const LENGTH_PARAMS: &[(&str, i32)] = &[("epsilon", 1), ("initial_max_jump", 1)];
+
 impl FairMethod for SapidisFarin {
     fn name(&self) -> &'static str {
         "sapidis-farin"
@@ -452,6 +457,22 @@ impl FairMethod for SapidisFarin {
 
     fn supports_closed(&self) -> bool {
         true
+    }
+
+    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
+        Ok(super::guard::length_params_at_scale(
+            options,
+            LENGTH_PARAMS,
+            s,
+        ))
+    }
+
+    fn report_params_at_scale(
+        &self,
+        parameters: &mut serde_json::Map<String, serde_json::Value>,
+        s: f64,
+    ) {
+        super::guard::report_length_params(parameters, LENGTH_PARAMS, s);
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {
