@@ -154,10 +154,25 @@ fn table(name: &str, e: &Evaluation) -> String {
     match (e.best_degree, e.fairness) {
         (Some(d), Some(f)) => {
             let label = DEGREE_NAMES.get(d.wrapping_sub(1)).copied().unwrap_or("?");
-            let _ = writeln!(
+            let _ = write!(
                 s,
                 "  best: {label} (degree {d}), fairness {f:.COSINE_DECIMALS$}"
             );
+            let max = e
+                .degrees
+                .iter()
+                .filter_map(|r| r.correlation)
+                .fold(f64::NEG_INFINITY, f64::max);
+            if max > f {
+                // A tie (kuragano::TIE_TOLERANCE) went to the lower degree: say so.
+                let _ = write!(
+                    s,
+                    " (the lowest degree within {:e} of the largest correlation, \
+                     {max:.COSINE_DECIMALS$})",
+                    kuragano::TIE_TOLERANCE
+                );
+            }
+            let _ = writeln!(s);
         }
         _ => {
             let _ = writeln!(

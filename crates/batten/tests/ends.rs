@@ -149,11 +149,13 @@ fn kuragano_holds_every_control_point_acting_at_an_end() {
         })
         .collect();
     let input = PointSeq::open(pts.clone()).unwrap();
-    let free = fair::fair("kuragano", &input, &FairOptions::default()).unwrap();
+    // The clean-curve guard would return this clean input unchanged: off, to see the ends.
+    let opts = FairOptions::default().with_keep_clean(false);
+    let free = fair::fair("kuragano", &input, &opts).unwrap();
     let held = fair::fair(
         "kuragano",
         &input,
-        &FairOptions::default().with_end_fix(EndFix::Curvature),
+        &opts.clone().with_end_fix(EndFix::Curvature),
     )
     .unwrap();
     let (c_free, c_held) = (free.curve.unwrap(), held.curve.unwrap());
@@ -168,7 +170,8 @@ fn kuragano_holds_every_control_point_acting_at_an_end() {
     let design = fair::fair(
         "kuragano",
         &input,
-        &FairOptions::default()
+        &opts
+            .clone()
             .with_end_fix(EndFix::Curvature)
             .with_max_iterations(0),
     )

@@ -11,6 +11,7 @@
 //! in [`methods`].
 
 pub mod cali;
+mod clean;
 pub mod eck_hadenfeld;
 mod guard;
 pub mod han;
@@ -26,6 +27,7 @@ pub mod smoothing;
 use std::time::Instant;
 
 pub use cali::Cali;
+pub use clean::LOCAL_CHECK_HALF_WIDTH;
 pub use eck_hadenfeld::EckHadenfeld;
 pub use guard::{CLEAN_SLACK_REL, METHOD_SCALE_RANGE_LOG2};
 pub use han::Han;
@@ -294,10 +296,11 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
         }
     } else {
         let s = guard::method_scale(input);
+        let run_options = guard::per_move_options(options, &before);
         if s == 1.0 {
-            m.run(input, options)?
+            m.run(input, &run_options)?
         } else {
-            let (unit, unit_options) = guard::to_unit(m, input, options, s)?;
+            let (unit, unit_options) = guard::to_unit(m, input, &run_options, s)?;
             let mut outcome = m.run(&unit, &unit_options)?;
             guard::from_unit(m, &mut outcome, s)?;
             outcome

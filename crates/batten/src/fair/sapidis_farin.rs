@@ -201,6 +201,9 @@ struct KnotState {
     held: usize,
     /// The number of points of a closed curve.
     period: Option<usize>,
+    /// Refuse moves that make the curve through the data points worse near them
+    /// ([`FairOptions::keep_clean`], the per-move clean-curve check).
+    keep_clean: bool,
 }
 
 impl KnotState {
@@ -369,6 +372,25 @@ impl LocalProblem for KnotState {
     fn max_displacement(&self) -> f64 {
         self.disp.max_value()
     }
+
+    fn worsens(&self, _j: usize, s: f64) -> bool {
+        if !self.keep_clean {
+            return false;
+        }
+        // The data points move by N_c(t_k)·s·d (the affected list of the plan).
+        let step = self.planned.1 * s;
+        let moved: Vec<(usize, Point)> = self
+            .affected
+            .iter()
+            .map(|&(k, n)| (k, self.q[k] + self.e[k] + step * n))
+            .collect();
+        super::clean::move_is_worse_by(
+            self.q.len(),
+            self.period.is_some(),
+            |k| self.q[k] + self.e[k],
+            &moved,
+        )
+    }
 }
 
 /// Padding of the wrapped form of a periodic cubic: period knot `τ_m` is knot index
@@ -504,6 +526,7 @@ impl FairMethod for SapidisFarin {
             affected: Vec::new(),
             held: options.fix_ends.held().max(2),
             period: closed.then_some(n),
+            keep_clean: options.keep_clean,
         };
         let candidates = if closed {
             n
