@@ -53,7 +53,7 @@ pub struct EvaluateArgs {
     /// Print a JSON object instead of a table
     #[arg(long)]
     json: bool,
-    /// Number of ρ samples along the normalised arc length [default: max(41, 10 per segment + 1)]
+    /// Number of ρ samples along the normalised arc length, at most 100000 [default: max(41, 10 per segment + 1)]
     #[arg(long, value_name = "N")]
     samples: Option<usize>,
     /// Cap on |ρ| in data units [default: 100 × the curve length]

@@ -142,6 +142,12 @@ pub const SAMPLES_PER_SEGMENT: usize = 10;
 /// Fewest samples accepted: a degree-6 fit needs seven.
 pub const MIN_SAMPLES: usize = MAX_DEGREE + 1;
 
+/// Most samples accepted when given (`samples`, `evaluate --samples`): each iteration
+/// samples ρ and fits the design at every one, about 1 s per 10⁵ for the evaluation and the
+/// shape modification (10⁶ took 11 s and 200 MB, 10⁷ 49 s and 1.9 GB; 2⁶⁴ overflowed the
+/// allocation). The automatic count, 10 per segment, is not capped.
+pub const MAX_SAMPLES: usize = 100_000;
+
 /// The default cap `ρ_max`, relative to the arc length of the curve: a sample whose radius
 /// exceeds 100 curve lengths (an arc turning by less than about 0.6°) counts as straight.
 pub const DEFAULT_RHO_MAX_REL: f64 = 100.0;
@@ -225,7 +231,7 @@ pub enum DesignEnds {
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct KuraganoOptions {
-    /// Number of ρ samples `N_s`; `None`: [`default_samples`].
+    /// Number of ρ samples `N_s`, in [`MIN_SAMPLES`]`..=`[`MAX_SAMPLES`]; `None`: [`default_samples`].
     ///
     /// Default value: `None`.
     pub samples: Option<usize>,
@@ -291,11 +297,11 @@ impl KuraganoOptions {
 
     fn check(&self) -> Result<()> {
         if let Some(n) = self.samples
-            && n < MIN_SAMPLES
+            && !(MIN_SAMPLES..=MAX_SAMPLES).contains(&n)
         {
             return Err(Error::InvalidParameter {
                 name: "samples".into(),
-                reason: format!("{n} is below the minimum {MIN_SAMPLES}"),
+                reason: format!("{n} is outside {MIN_SAMPLES}..={MAX_SAMPLES}"),
             });
         }
         if let Some(r) = self.rho_max
@@ -1573,7 +1579,7 @@ const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "samples",
         default: "auto",
-        doc: "number N_s of ρ samples along the normalised arc length; auto: max(41, 10 per segment + 1)",
+        doc: "number N_s of ρ samples along the normalised arc length, 7..=100000; auto: max(41, 10 per segment + 1)",
     },
     ParamSpec {
         name: "rho_max",
@@ -1617,7 +1623,7 @@ impl Kuragano {
                 "samples",
                 DEFAULT_SAMPLES,
                 MIN_SAMPLES,
-                usize::MAX,
+                MAX_SAMPLES,
             )?);
         }
         if !matches!(

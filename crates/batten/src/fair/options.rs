@@ -94,6 +94,12 @@ pub const AUTO_TOLERANCE_K: f64 = 3.0;
 ///
 /// Built with [`FairOptions::default`] and the `with_*` methods; the defaults are in
 /// [`FairOptions::DEFAULT`].
+/// The largest `max_iterations` accepted. A million single-point moves of the Kjellander
+/// family take about a second; beyond that a run is not converging but walking through
+/// rounding (`threshold=0` with 2⁶⁴ iterations ran for minutes and took a gigabyte for its
+/// move log).
+pub const MAX_ITERATIONS: usize = 1_000_000;
+
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct FairOptions {
@@ -113,8 +119,8 @@ pub struct FairOptions {
     ///
     /// Default value: [`EndFix::Free`].
     pub fix_ends: EndFix,
-    /// Upper bound on the method's iterations (its unit: sweeps, moves or passes).
-    /// `None`: the method's own default.
+    /// Upper bound on the method's iterations (its unit: sweeps, moves or passes), at most
+    /// [`MAX_ITERATIONS`]. `None`: the method's own default.
     ///
     /// Default value: `None`.
     pub max_iterations: Option<usize>,
@@ -197,6 +203,14 @@ impl FairOptions {
     /// # Errors
     /// [`Error::InvalidParameter`].
     pub fn validate(&self) -> Result<()> {
+        if let Some(n) = self.max_iterations
+            && n > MAX_ITERATIONS
+        {
+            return Err(Error::InvalidParameter {
+                name: "max_iterations".into(),
+                reason: format!("{n} is above the limit {MAX_ITERATIONS}"),
+            });
+        }
         if let Some(t) = self.tolerance
             && !(t.is_finite() && t > 0.0)
         {

@@ -11,5 +11,5 @@ mod transform;
 
 pub use point::{BBox, Point, Vec2, max_abs_coordinate};
 pub use scale::{pow2, scale_points, unit_scale};
-pub use seq::PointSeq;
+pub use seq::{NEAR_DUPLICATE_REL, PointSeq};
 pub use transform::Rigid;
