@@ -149,6 +149,23 @@ fn the_issue_table_comes_back_clean() {
             assert!(r.after.vibrations <= r.before.vibrations, "{name}");
         }
     }
+    // The bundled clothoid's truth: han took its GFI from 3.7e4 to 2.7e7.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/data/clothoid-truth.csv");
+    let seq = batten::io::read_points(&path, &batten::io::ReadOptions::default())
+        .expect("example")
+        .seq;
+    let out = fair("han", &seq, &FairOptions::default().with_tolerance(0.01)).expect("fair");
+    let r = &out.report;
+    assert!(r.after.variation_energy <= r.before.variation_energy * (1.0 + CLEAN_SLACK_REL));
+    assert!(r.after.inflections <= r.before.inflections);
+    assert!(r.after.vibrations <= r.before.vibrations);
+    assert!(
+        r.after.gfi <= 2.0 * r.before.gfi,
+        "{} -> {}",
+        r.before.gfi,
+        r.after.gfi
+    );
     // The per-move check (or the guard) says what it did, and keep_clean = false gives the
     // method as it is.
     let seq = PointSeq::open(clean_curve(0, 40).0).expect("points");
