@@ -692,7 +692,7 @@ fn curve_with_rho(rho: impl Fn(f64) -> f64, length: f64, n: usize) -> Vec<Point>
     for i in 1..=steps {
         // θ at the midpoint from the quadratic through the neighbouring nodes.
         let tm = 0.5 * (theta[i - 1] + theta[i])
-            + if i + 1 <= steps {
+            + if i < steps {
                 -(theta[i + 1] - 2.0 * theta[i] + theta[i - 1]) / 8.0
             } else {
                 -(theta[i] - 2.0 * theta[i - 1] + theta[i - 2]) / 8.0
