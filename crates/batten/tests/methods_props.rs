@@ -62,9 +62,10 @@ proptest! {
     }
 
     /// A rigid motion of the input gives the moved output. The methods work in intrinsic
-    /// quantities (chord lengths, curvature, local frames), so the results agree to rounding;
-    /// where a discrete choice (the worst point, a sign test at its zero threshold) parts the
-    /// runs, the counts and the tolerance still agree.
+    /// quantities (chord lengths, curvature, local frames) or, where a step depends on the
+    /// axes (`salvi`, `kuragano`), in the principal frame of the points, so the results agree
+    /// to rounding. A discrete choice at a knife edge (the worst point among near-ties, a sign
+    /// test at its zero threshold) may part one method's runs now and then.
     #[test]
     fn rigid_motion_moves_the_result(
         seed in any::<u64>(),
@@ -88,13 +89,15 @@ proptest! {
                 .map(|(p, q)| motion.apply(*p).distance(*q))
                 .fold(0.0, f64::max);
             if worst > 1e-7 * scale {
-                parted.push(name);
+                parted.push((name, worst / scale));
             }
             prop_assert_eq!(a.report.before.inflections, b.report.before.inflections, "{}", name);
             prop_assert!(b.report.tolerance_met, "{}", name);
         }
-        // Discrete choices may part one method's runs now and then, never most of them.
-        prop_assert!(parted.len() <= 2, "parted: {parted:?}");
+        // Knife edges part one or two methods' runs now and then (han and salvi by 0.1–0.3 %
+        // of the size after a translation), never most of them. Before the principal frame,
+        // salvi and kuragano parted on almost every rotation, by about 1 % of the size.
+        prop_assert!(parted.len() <= 2, "parted (method, distance / size): {parted:?}");
     }
 }
 

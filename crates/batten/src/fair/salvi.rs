@@ -884,8 +884,11 @@ impl FairMethod for Salvi {
     }
 
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
-        let fitted = local::fit_input(input, options)?;
-        run_fitted(fitted, input, options)
+        // The simplex is axis-aligned: run in the principal frame for rigid invariance.
+        super::guard::in_principal_frame(input, |input| {
+            let fitted = local::fit_input(input, options)?;
+            run_fitted(fitted, input, options)
+        })
     }
 
     fn run_curve_supported(&self) -> bool {
