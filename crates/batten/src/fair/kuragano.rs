@@ -301,7 +301,7 @@ impl KuraganoOptions {
         {
             return Err(Error::InvalidParameter {
                 name: "samples".into(),
-                reason: format!("{n} is outside {MIN_SAMPLES}..={MAX_SAMPLES}"),
+                reason: format!("{n} is outside [{MIN_SAMPLES}, {MAX_SAMPLES}]"),
             });
         }
         if let Some(r) = self.rho_max

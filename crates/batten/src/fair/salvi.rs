@@ -569,7 +569,7 @@ pub fn fair_curve(
     if n_samples < MIN_SAMPLES || params.samples.is_some_and(|n| n > MAX_SAMPLES) {
         return Err(Error::InvalidParameter {
             name: "samples".into(),
-            reason: format!("{n_samples} is outside {MIN_SAMPLES}..={MAX_SAMPLES}"),
+            reason: format!("{n_samples} is outside [{MIN_SAMPLES}, {MAX_SAMPLES}]"),
         });
     }
     let n_ctrl = curve.control_points().len();
