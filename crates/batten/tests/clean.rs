@@ -260,7 +260,8 @@ fn noisy_examples_are_still_faired() {
             }
             if r.status != FairStatus::NoChange {
                 assert!(r.after.inflections <= r.before.inflections, "{name} {file}");
-                assert!(r.after.vibrations <= r.before.vibrations, "{name} {file}");
+                let slack = 1.0 + CLEAN_SLACK_REL;
+                assert!(r.after.variation_energy <= r.before.variation_energy * slack);
             }
         }
     }

@@ -592,7 +592,12 @@ fn method_output_follows_the_specification() {
     );
     assert!(s1 < 1e-3 * s0, "{s1} vs {s0}");
     // Measured RMS(ρ − ρ̂) 2e-4 on ρ ≈ 1–2.2.
-    assert!(p["rho_rms"].as_f64().is_some_and(|r| r < 2e-3));
+    let rho_rms = p["rho_rms"].as_f64();
+    assert!(
+        rho_rms.is_some_and(|r| r < 2e-3),
+        "{rho_rms:?} {:?}",
+        out.report.notes
+    );
     // ρ of the faired curve is linear in s to that accuracy.
     let n = p["samples"].as_u64().expect("samples") as usize;
     let s = sample_rho(&c, n, None).expect("samples");

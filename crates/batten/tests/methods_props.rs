@@ -63,8 +63,8 @@ proptest! {
 
     /// A rigid motion of the input gives the moved output. The methods work in intrinsic
     /// quantities (chord lengths, curvature, local frames) or, where a step depends on the
-    /// axes (`salvi`, `kuragano`), in the principal frame of the points, so the results agree
-    /// to rounding. A discrete choice at a knife edge (the worst point among near-ties, a sign
+    /// axes (`salvi`), in the principal frame of the points, so the results agree to
+    /// rounding; `kuragano` is the exception. A discrete choice at a knife edge (the worst point among near-ties, a sign
     /// test at its zero threshold) may part one method's runs now and then.
     #[test]
     fn rigid_motion_moves_the_result(
@@ -82,7 +82,8 @@ proptest! {
         let opts = FairOptions::default().with_tolerance(0.05);
         let scale = seq.bbox().diagonal();
         let mut parted = Vec::new();
-        for name in names() {
+        // kuragano is not rotation invariant (the spec's Marquardt scaling, see its `run`).
+        for name in names().into_iter().filter(|&n| n != "kuragano") {
             let a = fair(name, &seq, &opts).unwrap_or_else(|e| panic!("{name}: {e}"));
             let b = fair(name, &moved, &opts).unwrap_or_else(|e| panic!("{name}: {e}"));
             let worst = a.points.iter().zip(&b.points)

@@ -1692,9 +1692,11 @@ impl FairMethod for Kuragano {
     }
 
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
-        // The Marquardt scaling diag(JᵀJ) depends on the axes: run in the principal frame
-        // for rigid invariance.
-        super::guard::in_principal_frame(input, |input| run_points(input, options))
+        // Not rotation invariant: the spec's Marquardt scaling diag(JᵀJ) depends on the
+        // axes. Neither the principal frame nor a rotation-invariant scaling (the x and y
+        // entries of a control point averaged) helped: each converged worse on the spec's
+        // tests (degree 6: S 69 instead of below 1 % of S₀).
+        run_points(input, options)
     }
 }
 

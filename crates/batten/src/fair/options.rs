@@ -130,8 +130,8 @@ pub struct FairOptions {
     /// Default value: empty.
     pub params: BTreeMap<String, String>,
     /// The clean-curve guard: return the input unchanged (status `no_change`, with a note)
-    /// when a method's result has more inflections, more curvature vibrations or a higher
-    /// variation energy than its input; and, on an input without inflections or vibrations,
+    /// when a method's result has more inflections, more curvature vibrations (for an input
+    /// without inflections) or a higher variation energy than its input; and, on an input without inflections or vibrations,
     /// the per-move check of the local methods (`han`, the Kjellander family,
     /// `sapidis-farin`, `eck-hadenfeld`), which refuse single moves that would make the
     /// curve worse near them. Methods exempt from it (`mst`, the csaps baseline) say so in
