@@ -13,9 +13,9 @@
 //! - **Clean curves come back clean.** A result with more inflections, more curvature
 //!   vibrations (sign changes of the jumps of dκ/ds) than an input without inflections, or a
 //!   higher variation energy `∫(dκ/ds)² ds` than its input (all on the analysis curve,
-//!   [`FairnessMetrics`]) is replaced by the input, with status `no_change` and a note. The comparison allows a
-//!   relative slack of [`CLEAN_SLACK_REL`] on the energy, the size of rounding in its
-//!   computation. `mst` (the csaps baseline) is exempt
+//!   [`FairnessMetrics`]) is replaced by the input, with status `no_change` and a note. The
+//!   comparison allows a relative slack of [`CLEAN_SLACK_REL`] on the energy, the size of
+//!   rounding in its computation. `mst` (the csaps baseline) is exempt
 //!   ([`super::FairMethod::keeps_clean`]), and [`super::FairOptions::keep_clean`] turns the
 //!   guard off. The per-move half of the promise, for clean inputs, is in `clean.rs`.
 
