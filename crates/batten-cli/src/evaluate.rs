@@ -52,7 +52,7 @@ pub struct EvaluateArgs {
     /// Print a JSON object instead of a table
     #[arg(long)]
     json: bool,
-    /// Number of ρ samples along the normalised arc length [default: max(41, 10 per segment + 1)]
+    /// Number of ρ samples along the normalised arc length, at most 100000 [default: max(41, 10 per segment + 1)]
     #[arg(long, value_name = "N")]
     samples: Option<usize>,
     /// Cap on |ρ| in data units [default: 100 × the curve length]
@@ -153,10 +153,25 @@ fn table(name: &str, e: &Evaluation) -> String {
     match (e.best_degree, e.fairness) {
         (Some(d), Some(f)) => {
             let label = DEGREE_NAMES.get(d.wrapping_sub(1)).copied().unwrap_or("?");
-            let _ = writeln!(
+            let _ = write!(
                 s,
                 "  best: {label} (degree {d}), fairness {f:.COSINE_DECIMALS$}"
             );
+            let max = e
+                .degrees
+                .iter()
+                .filter_map(|r| r.correlation)
+                .fold(f64::NEG_INFINITY, f64::max);
+            if max > f {
+                // A tie (kuragano::TIE_TOLERANCE) went to the lower degree: say so.
+                let _ = write!(
+                    s,
+                    " (the lowest degree within {:e} of the largest correlation, \
+                     {max:.COSINE_DECIMALS$})",
+                    kuragano::TIE_TOLERANCE
+                );
+            }
+            let _ = writeln!(s);
         }
         _ => {
             let _ = writeln!(

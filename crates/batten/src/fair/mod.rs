@@ -13,7 +13,9 @@
 pub mod band;
 pub mod cali;
 mod catalogue;
+mod clean;
 pub mod eck_hadenfeld;
+mod guard;
 pub mod han;
 pub mod kjellander;
 pub mod kuragano;
@@ -29,12 +31,14 @@ use std::time::Instant;
 pub use band::Band;
 pub use cali::Cali;
 pub use catalogue::{MethodInfo, ParamInfo, ParamType, catalogue};
+pub use clean::LOCAL_CHECK_HALF_WIDTH;
 pub use eck_hadenfeld::EckHadenfeld;
+pub use guard::{CLEAN_SLACK_REL, METHOD_SCALE_RANGE_LOG2};
 pub use han::Han;
 pub use kjellander::{
     Energy, HermiteMove, Kjellander, KpRule, Poliakoff, fair_hermite, hermite_step,
 };
-pub use options::{AUTO_TOLERANCE_K, EndFix, FairOptions, ParamSpec};
+pub use options::{AUTO_TOLERANCE_K, EndFix, FairOptions, MAX_ITERATIONS, ParamSpec};
 pub use report::{
     EndChanges, FairReport, FairStatus, HistoryRow, Move, SolverInfo, ToleranceSource,
 };
@@ -129,6 +133,33 @@ pub trait FairMethod: Sync {
     fn auto_tolerance_factor(&self, options: &FairOptions) -> Result<f64> {
         let _ = options;
         Ok(AUTO_TOLERANCE_K)
+    }
+
+    /// Whether the clean-curve guard applies ([`FairOptions::keep_clean`]): `true` (the
+    /// default) for every method but the csaps baseline `mst`.
+    fn keeps_clean(&self) -> bool {
+        true
+    }
+
+    /// The options for a run on the coordinates divided by `s` (a power of two, see
+    /// [`METHOD_SCALE_RANGE_LOG2`]): parameters given in data units converted. The common
+    /// path divides the tolerance itself. The default: no parameter in data units.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a value that cannot be converted.
+    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
+        let _ = s;
+        Ok(options.clone())
+    }
+
+    /// Convert the reported parameters of a run on the coordinates divided by `s` back to
+    /// data units, where the method has some in data units. The default: none.
+    fn report_params_at_scale(
+        &self,
+        parameters: &mut serde_json::Map<String, serde_json::Value>,
+        s: f64,
+    ) {
+        let _ = (parameters, s);
     }
 }
 
@@ -254,7 +285,8 @@ pub fn fair(name: &str, input: &PointSeq, options: &FairOptions) -> Result<Faire
 /// As [`fair`].
 pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) -> Result<Faired> {
     check_options(m, input.is_closed(), options)?;
-    let before = FairnessMetrics::of_seq(input)?;
+    let unit_scale = crate::geom::unit_scale(input.points());
+    let before = FairnessMetrics::of_seq(&in_unit(input, unit_scale)?)?;
     let start = Instant::now();
     let sigma = noise_sigma(input.points(), input.is_closed());
     let (resolved, source) = resolve_tolerance(m, options, sigma, input.bbox().diagonal())?;
@@ -273,12 +305,21 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
             ..Outcome::default()
         }
     } else {
-        m.run(input, options)?
+        let s = guard::method_scale(input);
+        let run_options = guard::per_move_options(options, &before);
+        if s == 1.0 {
+            m.run(input, &run_options)?
+        } else {
+            let (unit, unit_options) = guard::to_unit(m, input, &run_options, s)?;
+            let mut outcome = m.run(&unit, &unit_options)?;
+            guard::from_unit(m, &mut outcome, s)?;
+            outcome
+        }
     };
     finish(
         m,
-        input,
-        before,
+        (input, None),
+        (before, unit_scale),
         options,
         outcome,
         start,
@@ -377,17 +418,36 @@ pub fn fair_curve(name: &str, curve: &BSplineCurve, options: &FairOptions) -> Re
         });
     };
     let (input, outcome) = run?;
-    let before = FairnessMetrics::of_seq(&input)?;
-    finish(m, &input, before, options, outcome, start, (source, None))
+    let unit_scale = crate::geom::unit_scale(input.points());
+    let before = FairnessMetrics::of_seq(&in_unit(&input, unit_scale)?)?;
+    finish(
+        m,
+        (&input, Some(curve)),
+        (before, unit_scale),
+        options,
+        outcome,
+        start,
+        (source, None),
+    )
 }
 
-/// The common part of every report: displacements, metrics after, the tolerance verdict.
+/// `seq` divided by `s` (exact: `s` is a power of two).
+fn in_unit(seq: &PointSeq, s: f64) -> Result<PointSeq> {
+    if s == 1.0 {
+        return Ok(seq.clone());
+    }
+    seq.with_points(crate::geom::scale_points(seq.points(), 1.0 / s))
+}
+
+/// The common part of every report: the clean-curve guard, displacements, metrics after,
+/// the tolerance verdict. `before` is measured on the input divided by `unit_scale`, and
+/// `curve` is the input curve of [`fair_curve`].
 fn finish(
     m: &dyn FairMethod,
-    input: &PointSeq,
-    before: FairnessMetrics,
+    (input, curve): (&PointSeq, Option<&BSplineCurve>),
+    (before, unit_scale): (FairnessMetrics, f64),
     options: &FairOptions,
-    outcome: Outcome,
+    mut outcome: Outcome,
     start: Instant,
     (tolerance_source, noise_sigma): (Option<ToleranceSource>, Option<f64>),
 ) -> Result<Faired> {
@@ -399,8 +459,33 @@ fn finish(
             expected: input.len(),
         });
     }
-    let faired = input.with_points(outcome.points.clone())?;
-    let after = FairnessMetrics::of_seq(&faired)?;
+    let mut faired = input.with_points(outcome.points.clone())?;
+    let mut after = FairnessMetrics::of_seq(&in_unit(&faired, unit_scale)?)?;
+    if options.keep_clean
+        && m.keeps_clean()
+        && let Some(why) = guard::worse(&before, &after)
+    {
+        outcome = Outcome {
+            points: input.points().to_vec(),
+            status: FairStatus::NoChange,
+            iterations: outcome.iterations,
+            history: outcome.history,
+            parameters: outcome.parameters,
+            notes: {
+                let mut notes = outcome.notes;
+                notes.push(format!(
+                    "the result had {why} than the input, so the input is returned unchanged \
+                     (the clean-curve guard; keep_clean = false turns it off)"
+                ));
+                notes
+            },
+            curve: curve.cloned(),
+            ..Outcome::default()
+        };
+        faired = input.clone();
+        after = before.clone();
+    }
+    let (before, after) = (before.rescaled(unit_scale), after.rescaled(unit_scale));
     let end_changes = end_changes(input, &faired);
     let disp = displacement(input.points(), &outcome.points)?;
     let tolerance_met = options.tolerance.is_none_or(|d| disp.max <= d);

@@ -94,6 +94,12 @@ pub const AUTO_TOLERANCE_K: f64 = 3.0;
 ///
 /// Built with [`FairOptions::default`] and the `with_*` methods; the defaults are in
 /// [`FairOptions::DEFAULT`].
+/// The largest `max_iterations` accepted. A million single-point moves of the Kjellander
+/// family take about a second; beyond that a run is not converging but walking through
+/// rounding (`threshold=0` with 2⁶⁴ iterations ran for minutes and took a gigabyte for its
+/// move log).
+pub const MAX_ITERATIONS: usize = 1_000_000;
+
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct FairOptions {
@@ -113,8 +119,8 @@ pub struct FairOptions {
     ///
     /// Default value: [`EndFix::Free`].
     pub fix_ends: EndFix,
-    /// Upper bound on the method's iterations (its unit: sweeps, moves or passes).
-    /// `None`: the method's own default.
+    /// Upper bound on the method's iterations (its unit: sweeps, moves or passes), at most
+    /// [`MAX_ITERATIONS`]. `None`: the method's own default.
     ///
     /// Default value: `None`.
     pub max_iterations: Option<usize>,
@@ -123,6 +129,17 @@ pub struct FairOptions {
     ///
     /// Default value: empty.
     pub params: BTreeMap<String, String>,
+    /// The clean-curve guard: return the input unchanged (status `no_change`, with a note)
+    /// when a method's result has more inflections, more curvature vibrations (for an input
+    /// without inflections) or a higher variation energy than its input; and, on an input without inflections or vibrations,
+    /// the per-move check of the local methods (`han`, the Kjellander family,
+    /// `sapidis-farin`, `eck-hadenfeld`), which refuse single moves that would make the
+    /// curve worse near them. Methods exempt from it (`mst`, the csaps baseline) say so in
+    /// [`super::FairMethod::keeps_clean`]. `false` gives the methods as their papers state
+    /// them.
+    ///
+    /// Default value: `true`.
+    pub keep_clean: bool,
 }
 
 impl FairOptions {
@@ -134,6 +151,7 @@ impl FairOptions {
         fix_ends: EndFix::Free,
         max_iterations: None,
         params: BTreeMap::new(),
+        keep_clean: true,
     };
 
     /// Set the tolerance (largest allowed point displacement, data units).
@@ -168,6 +186,12 @@ impl FairOptions {
         self
     }
 
+    /// Turn the clean-curve guard on or off ([`FairOptions::keep_clean`]).
+    pub fn with_keep_clean(mut self, keep: bool) -> FairOptions {
+        self.keep_clean = keep;
+        self
+    }
+
     /// Set one method parameter.
     pub fn with_param(mut self, key: &str, value: impl ToString) -> FairOptions {
         self.params.insert(key.to_string(), value.to_string());
@@ -179,6 +203,14 @@ impl FairOptions {
     /// # Errors
     /// [`Error::InvalidParameter`].
     pub fn validate(&self) -> Result<()> {
+        if let Some(n) = self.max_iterations
+            && n > MAX_ITERATIONS
+        {
+            return Err(Error::InvalidParameter {
+                name: "max_iterations".into(),
+                reason: format!("{n} is above the limit {MAX_ITERATIONS}"),
+            });
+        }
         if let Some(t) = self.tolerance
             && !(t.is_finite() && t > 0.0)
         {

@@ -18,7 +18,8 @@ pub enum FairStatus {
     ToleranceLimited,
     /// The result exceeds the tolerance (the method could not meet it).
     ToleranceExceeded,
-    /// Nothing needed to change (the input is already fair by the method's criterion).
+    /// Nothing changed: the input is already fair by the method's criterion, or the
+    /// clean-curve guard returned the input because the result was worse (a note says so).
     NoChange,
 }
 

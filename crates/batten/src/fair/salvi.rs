@@ -100,6 +100,12 @@ pub const SAMPLES_PER_SPAN: usize = 8;
 /// Fewest samples accepted.
 pub const MIN_SAMPLES: usize = 4;
 
+/// Most samples accepted when given: every iteration evaluates its simplex over the samples
+/// of one support, so a run costs about 1 ms per 1000 samples per iteration (20 000 samples
+/// and the default 1000 iterations: about 20 s; 10⁶ ran for more than 5 minutes). The
+/// automatic count, 8 per knot span, is not capped.
+pub const MAX_SAMPLES: usize = 20_000;
+
 /// The moving-average half-width is `⌊N / HALF_WIDTH_DIVISOR⌋` (spec §3 step 3.2).
 pub const HALF_WIDTH_DIVISOR: usize = 20;
 
@@ -171,7 +177,7 @@ impl Default for Smoother {
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct SalviParams {
-    /// Number of samples N; `None`: `max(200, 8 × non-empty spans)`.
+    /// Number of samples N, at most [`MAX_SAMPLES`]; `None`: `max(200, 8 × non-empty spans)`.
     ///
     /// Default value: `None`.
     pub samples: Option<usize>,
@@ -560,10 +566,10 @@ pub fn fair_curve(
     }
     let delta = resolve_tolerance(params.tolerance, curve)?;
     let n_samples = sample_count(curve, params.samples);
-    if n_samples < MIN_SAMPLES {
+    if n_samples < MIN_SAMPLES || params.samples.is_some_and(|n| n > MAX_SAMPLES) {
         return Err(Error::InvalidParameter {
             name: "samples".into(),
-            reason: format!("{n_samples} is below {MIN_SAMPLES}"),
+            reason: format!("{n_samples} is outside [{MIN_SAMPLES}, {MAX_SAMPLES}]"),
         });
     }
     let n_ctrl = curve.control_points().len();
@@ -812,7 +818,7 @@ static PARAMS: [ParamSpec; 11] = [
     ParamSpec {
         name: "samples",
         default: "auto",
-        doc: "number of curvature samples N (auto: max(200, 8 per knot span))",
+        doc: "number of curvature samples N, 4..=20000 (auto: max(200, 8 per knot span))",
     },
     ParamSpec {
         name: "smoother",
@@ -878,8 +884,11 @@ impl FairMethod for Salvi {
     }
 
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
-        let fitted = local::fit_input(input, options)?;
-        run_fitted(fitted, input, options)
+        // The simplex is axis-aligned: run in the principal frame for rigid invariance.
+        super::guard::in_principal_frame(input, |input| {
+            let fitted = local::fit_input(input, options)?;
+            run_fitted(fitted, input, options)
+        })
     }
 
     fn run_curve_supported(&self) -> bool {
@@ -962,7 +971,7 @@ fn salvi_params(
     let samples = match options.params.get("samples").map(|s| s.trim()) {
         None | Some("auto") => None,
         Some(_) => {
-            Some(options.param_usize_in("samples", DEFAULT_SAMPLES, MIN_SAMPLES, 10_000_000)?)
+            Some(options.param_usize_in("samples", DEFAULT_SAMPLES, MIN_SAMPLES, MAX_SAMPLES)?)
         }
     };
     let auto_usize = |key: &str, lo: usize| -> Result<Option<usize>> {
