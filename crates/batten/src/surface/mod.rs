@@ -1,0 +1,10 @@
+//! B-spline surfaces: representation, interrogation and fairing.
+//!
+//! - [`BSplineSurface`]: a tensor-product B-spline or NURBS surface of any degrees on clamped
+//!   knots, with partial derivatives up to second order, the normal, the fundamental forms and
+//!   the principal, Gaussian and mean curvatures (spec §0.6, κ1 ≥ κ2, signs following
+//!   `S_u × S_v`).
+
+mod patch;
+
+pub use patch::{BSplineSurface, FundamentalForms, SurfaceCurvature, SurfaceDerivs, Xyz};
