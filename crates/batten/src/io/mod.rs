@@ -47,6 +47,7 @@
 
 mod error;
 mod json;
+mod surface;
 mod text;
 
 use std::fs;
@@ -55,6 +56,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 pub use error::IoError;
+pub use surface::{format_surface, parse_surface, read_surface_json, write_surface_json};
 pub use text::format_f64;
 
 use crate::error::Error;
