@@ -21,6 +21,7 @@ mod methods;
 mod output;
 mod plot;
 mod report;
+mod surface_cmd;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -59,6 +60,10 @@ enum Command {
     Batch(batch::BatchArgs),
     /// Kuragano & Yamaguchi's fairness evaluation: which polynomial ρ(s) the curve follows best
     Evaluate(evaluate::EvaluateArgs),
+    /// Curvature ranges, umbilics and the fairness measure of a B-spline surface (JSON)
+    AnalyzeSurface(surface_cmd::AnalyzeSurfaceArgs),
+    /// Fair a B-spline surface (JSON) within a tolerance: salvi or eck-hadenfeld
+    FairSurface(surface_cmd::FairSurfaceArgs),
 }
 
 /// Arguments of `batten analyze`.
@@ -165,6 +170,8 @@ fn main() -> ExitCode {
         Command::Report(a) => report::run(&a),
         Command::Batch(a) => batch::run(&a),
         Command::Evaluate(a) => evaluate::run(&a),
+        Command::AnalyzeSurface(a) => surface_cmd::analyze(&a),
+        Command::FairSurface(a) => surface_cmd::fair(&a),
     };
     match result {
         Ok(code) => code,
