@@ -12,11 +12,15 @@
 //!   [`salvi`] (target principal curvatures, one control point at a time by 3-D
 //!   Nelder–Mead) or [`eck_hadenfeld`] (the closed-form local minimiser of the thin-plate
 //!   energy), with the boundary rows optionally held ([`BoundaryFix`]).
+//! - [`render`]: pictures for interrogation — curvature colour maps, isophotes, zebra
+//!   stripes and the deviation between two surfaces — rasterised from a [`SurfaceMesh`] in an
+//!   orthographic [`Camera`] view into an RGBA [`Raster`].
 
 pub mod eck_hadenfeld;
 mod fairing;
 mod fit;
 mod patch;
+mod render;
 pub mod salvi;
 mod sample;
 mod target;
@@ -27,6 +31,10 @@ pub use fairing::{
 };
 pub use fit::{GRID_FIT_DEGREE, interpolate_grid};
 pub use patch::{BSplineSurface, FundamentalForms, SurfaceCurvature, SurfaceDerivs, Xyz};
+pub use render::{
+    BACKGROUND_RGB, Camera, Field, MAP_SHADE_FLOOR, MESH_MIN_SAMPLES, MESH_SAMPLES_PER_SPAN,
+    Palette, Raster, SINGULAR_RGB, Shading, SurfaceMesh, render,
+};
 pub use sample::{
     MIN_SAMPLES, MinMax, SAMPLES_PER_SPAN, SampleGrid, SurfaceAnalysis, UMBILIC_REL,
     analyze_surface, sample_curvature,
