@@ -16,12 +16,14 @@ mod compare;
 mod evaluate;
 mod failure;
 mod fair_cmd;
+mod figure;
 mod input;
 mod methods;
 mod output;
 mod plot;
 mod report;
 mod surface_cmd;
+mod surface_plot;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -64,6 +66,8 @@ enum Command {
     AnalyzeSurface(surface_cmd::AnalyzeSurfaceArgs),
     /// Fair a B-spline surface (JSON) within a tolerance: salvi or eck-hadenfeld
     FairSurface(surface_cmd::FairSurfaceArgs),
+    /// Curvature maps, isophotes, zebra and deviation of a B-spline surface (PNG or SVG)
+    PlotSurface(surface_plot::PlotSurfaceArgs),
 }
 
 /// Arguments of `batten analyze`.
@@ -172,6 +176,7 @@ fn main() -> ExitCode {
         Command::Evaluate(a) => evaluate::run(&a),
         Command::AnalyzeSurface(a) => surface_cmd::analyze(&a),
         Command::FairSurface(a) => surface_cmd::fair(&a),
+        Command::PlotSurface(a) => surface_plot::run(&a),
     };
     match result {
         Ok(code) => code,

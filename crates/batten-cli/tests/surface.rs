@@ -201,3 +201,177 @@ fn a_plane_comes_back_unchanged_with_exit_0() {
         }
     }
 }
+
+/// Decode a PNG: `(width, height, rgba)`.
+fn read_png(path: &Path) -> (u32, u32, Vec<u8>) {
+    let decoder = png::Decoder::new(std::io::BufReader::new(fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgba);
+    buf.truncate(info.buffer_size());
+    (info.width, info.height, buf)
+}
+
+/// The distinct colours inside a rectangle of an RGBA image `width` wide.
+fn colours(rgba: &[u8], width: u32, x: std::ops::Range<u32>, y: std::ops::Range<u32>) -> usize {
+    let mut seen = std::collections::HashSet::new();
+    for j in y {
+        for i in x.clone() {
+            let k = 4 * (j * width + i) as usize;
+            seen.insert([rgba[k], rgba[k + 1], rgba[k + 2]]);
+        }
+    }
+    seen.len()
+}
+
+#[test]
+fn plot_surface_draws_before_and_after_as_png_and_svg() {
+    let dir = tempfile::tempdir().unwrap();
+    let (faired, png_out, svg_out) = (
+        dir.path().join("f.json"),
+        dir.path().join("p.png"),
+        dir.path().join("p.svg"),
+    );
+    let dented = example("hood-dented.json");
+    let o = batten(&[
+        "fair-surface",
+        s(&dented),
+        "-o",
+        s(&faired),
+        "--method",
+        "eck-hadenfeld",
+        "--fix-boundary",
+        "--max-iterations",
+        "60",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // One row, two panels of 200 x 150 and a colour bar: the page size of the layout
+    // (8-pixel gaps, a 24-pixel title strip, 110 pixels for the bar).
+    let o = batten(&[
+        "plot-surface",
+        s(&dented),
+        "--faired",
+        s(&faired),
+        "--kind",
+        "mean",
+        "--width",
+        "200",
+        "--height",
+        "150",
+        "-o",
+        s(&png_out),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (w, h, rgba) = read_png(&png_out);
+    assert_eq!((w, h), (8 + 2 * 208 + 110, 8 + 24 + 150 + 8));
+    // Both panels hold a coloured surface (many colours), not a blank.
+    let y = 32..182;
+    assert!(colours(&rgba, w, 8..208, y.clone()) > 50);
+    assert!(colours(&rgba, w, 216..416, y) > 50);
+    // `all` with --faired: seven rows (K, H, kappa1, kappa2, isophotes, zebra, deviation).
+    let o = batten(&[
+        "plot-surface",
+        s(&dented),
+        "--faired",
+        s(&faired),
+        "--width",
+        "100",
+        "--height",
+        "80",
+        "-o",
+        s(&png_out),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(read_png(&png_out).1, 8 + 7 * (24 + 80 + 8));
+    // Without --faired: six rows of one panel.
+    let o = batten(&[
+        "plot-surface",
+        s(&dented),
+        "--width",
+        "100",
+        "--height",
+        "80",
+        "-o",
+        s(&png_out),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (w, h, _) = read_png(&png_out);
+    assert_eq!((w, h), (8 + 108 + 110, 8 + 6 * (24 + 80 + 8)));
+    // SVG: the panels embedded as PNG, the title and the bar's numbers as text.
+    let o = batten(&[
+        "plot-surface",
+        s(&dented),
+        "--faired",
+        s(&faired),
+        "--kind",
+        "zebra",
+        "-o",
+        s(&svg_out),
+        "--view",
+        "0,-1,2",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let svg = fs::read_to_string(&svg_out).unwrap();
+    assert!(svg.starts_with("<svg"), "{svg:.80}");
+    assert_eq!(svg.matches("data:image/png;base64,").count(), 2);
+    assert!(svg.contains("zebra - before (left), after (right)"));
+    // Deviation: one panel, a bar from 0 to the largest distance.
+    let o = batten(&[
+        "plot-surface",
+        s(&dented),
+        "--faired",
+        s(&faired),
+        "--kind",
+        "deviation",
+        "-o",
+        s(&svg_out),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let svg = fs::read_to_string(&svg_out).unwrap();
+    assert_eq!(svg.matches("data:image/png;base64,").count(), 2);
+    assert!(svg.contains(">0</text>"), "{svg}");
+}
+
+#[test]
+fn plot_surface_refuses_bad_requests_without_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("p.png");
+    let hood = example("hood.json");
+    let bad = dir.path().join("bad.json");
+    fs::write(&bad, "{\"degree_u\": 3}").unwrap();
+    let other = dir.path().join("other.json");
+    fs::write(
+        &other,
+        "{\"degree_u\": 1, \"degree_v\": 1, \"knots_u\": [0, 0, 2, 2], \"knots_v\": [0, 0, 1, 1], \
+         \"control_points\": [[[0, 0, 0], [0, 1, 0]], [[1, 0, 0], [1, 1, 0]]]}",
+    )
+    .unwrap();
+    let gif = dir.path().join("p.gif");
+    let missing = dir.path().join("missing").join("p.png");
+    let cases: [(Vec<&str>, &[&str]); 6] = [
+        (
+            vec!["--kind", "deviation"],
+            &["--kind deviation needs --faired"],
+        ),
+        (vec!["--width", "10"], &["--width 10", "64 to 4096"]),
+        (vec!["--faired", s(&bad)], &["bad.json", "degree_v"]),
+        (vec!["--faired", s(&other)], &["other.json", "domain"]),
+        (vec!["-o", s(&missing)], &["missing", "does not exist"]),
+        (vec!["-o", s(&gif)], &["p.gif", ".png or .svg"]),
+    ];
+    for (extra, needles) in cases {
+        let mut args = vec!["plot-surface", s(&hood)];
+        if !extra.contains(&"-o") {
+            args.extend(["-o", s(&out)]);
+        }
+        args.extend(extra);
+        assert_usage_error(&batten(&args), needles);
+        assert!(!out.exists());
+    }
+    // Parse errors come from clap: exit 2, nothing written.
+    let o = batten(&["plot-surface", s(&hood), "-o", s(&out), "--view", "0,0,0"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("zero vector"));
+    assert!(!out.exists());
+}

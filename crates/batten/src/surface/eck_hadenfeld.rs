@@ -155,7 +155,9 @@ pub(crate) fn run(p: &Problem<'_>) -> Result<MethodRun> {
             })
             .collect();
         let best = gains.iter().fold(0.0f64, |m, &x| m.max(x));
-        if !(best > MIN_REL_DECREASE * energy) || p.delta <= 0.0 {
+        // NaN energies stop the run too.
+        let worth_it = best > MIN_REL_DECREASE * energy;
+        if !worth_it || p.delta <= 0.0 {
             status = if moves == 0 {
                 FairStatus::NoChange
             } else {

@@ -45,7 +45,7 @@ pub fn interpolate_grid(grid: &[Vec<Xyz>]) -> Result<BSplineSurface> {
     }
     let at = |i: usize, j: usize| flat[i * nv + j];
     // Parameters along u from the columns, along v from the rows.
-    let su = averaged_chord_parameters(nu, nv, |k, a| at(k, a))?;
+    let su = averaged_chord_parameters(nu, nv, at)?;
     let sv = averaged_chord_parameters(nv, nu, |k, a| at(a, k))?;
     let (p, q) = (GRID_FIT_DEGREE.min(nu - 1), GRID_FIT_DEGREE.min(nv - 1));
     let ku = averaged_knots(&su, p)?;

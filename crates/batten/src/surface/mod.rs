@@ -33,7 +33,7 @@ pub use fit::{GRID_FIT_DEGREE, interpolate_grid};
 pub use patch::{BSplineSurface, FundamentalForms, SurfaceCurvature, SurfaceDerivs, Xyz};
 pub use render::{
     BACKGROUND_RGB, Camera, Field, MAP_SHADE_FLOOR, MESH_MIN_SAMPLES, MESH_SAMPLES_PER_SPAN,
-    Palette, Raster, SINGULAR_RGB, Shading, SurfaceMesh, render,
+    Palette, Raster, SINGULAR_RGB, Shading, SurfaceMesh, isophote_range, render, zebra_range,
 };
 pub use sample::{
     MIN_SAMPLES, MinMax, SAMPLES_PER_SPAN, SampleGrid, SurfaceAnalysis, UMBILIC_REL,

@@ -10,7 +10,7 @@
 //!   black line where the band changes. A G1 (tangent) break makes the lines jump, a G2
 //!   (curvature) break makes them kink, a dent closes them into rings;
 //! - zebra: the reflection `r = 2(n·e)n − e` of a room lit by parallel tubes that run along
-//!   the picture's vertical, black and white by the angle of `r` about that axis. Stripes
+//!   the picture's horizontal, black and white by the angle of `r` about that axis. Stripes
 //!   are continuous across a G1-continuous surface and smooth across a G2 one.
 //!
 //! Normals are evaluated exactly at the mesh vertices and interpolated per pixel; both sides
@@ -107,15 +107,25 @@ pub enum Shading {
         /// The palette.
         palette: Palette,
     },
-    /// Isophotes of `n·light` in `bands` bands over `[−1, 1]`.
+    /// Isophotes: `bands` bands of equal width of the brightness `n·light` over `[lo, hi]`
+    /// (see [`isophote_range`] for the range seen on given meshes).
     Isophotes {
         /// Direction towards the light (need not be unit).
         light: Xyz,
+        /// The brightness at the first band's start.
+        lo: f64,
+        /// The brightness at the last band's end.
+        hi: f64,
         /// Number of bands.
         bands: usize,
     },
-    /// Zebra stripes: `stripes` black and white pairs over a half turn of the reflection.
+    /// Zebra: `stripes` black and `stripes` white stripes over the angle range `[lo, hi]`
+    /// of the reflection about the tubes (see [`zebra_range`]).
     Zebra {
+        /// The angle at the first stripe's start, in radians.
+        lo: f64,
+        /// The angle at the last stripe's end.
+        hi: f64,
         /// Number of stripe pairs.
         stripes: usize,
     },
@@ -394,20 +404,21 @@ pub fn render(mesh: &SurfaceMesh, camera: &Camera, shading: &Shading) -> Raster 
                     let k = MAP_SHADE_FLOOR + (1.0 - MAP_SHADE_FLOOR) * facing;
                     c.map(|v| (f64::from(v) * k).round() as u8)
                 }
-                Shading::Isophotes { light, bands } => {
-                    let l = unit(light).unwrap_or(eye);
-                    let i = dot(n, l).clamp(-1.0, 1.0);
-                    let b = (((i + 1.0) / 2.0) * bands as f64)
-                        .floor()
-                        .min(bands as f64 - 1.0);
-                    band[y * w + x] = Some(b as i64);
-                    let t = (b + 0.5) / bands as f64;
+                Shading::Isophotes {
+                    light,
+                    lo,
+                    hi,
+                    bands,
+                } => {
+                    let i = brightness(n, light, eye);
+                    // The brightest value `hi` belongs to the last band, not a new one.
+                    let b = band_of(i, lo, hi, bands).clamp(0, bands.max(1) as i64 - 1);
+                    band[y * w + x] = Some(b);
+                    let t = (b as f64 + 0.5) / bands.max(1) as f64;
                     isophote_colour(t)
                 }
-                Shading::Zebra { stripes } => {
-                    let r = sub(scale(n, 2.0 * dot(n, eye)), eye);
-                    let phi = dot(r, camera.right).atan2(dot(r, eye));
-                    let k = (phi / std::f64::consts::PI * stripes as f64).floor() as i64;
+                Shading::Zebra { lo, hi, stripes } => {
+                    let k = band_of(zebra_angle(n, camera), lo, hi, 2 * stripes);
                     if k.rem_euclid(2) == 0 {
                         [250, 250, 250]
                     } else {
@@ -431,6 +442,62 @@ pub fn render(mesh: &SurfaceMesh, camera: &Camera, shading: &Shading) -> Raster 
         }
     }
     out
+}
+
+/// The brightness `n·l` of a unit normal already turned towards the viewer, for a light
+/// along `light` (along `eye` when `light` is zero).
+fn brightness(n: Xyz, light: Xyz, eye: Xyz) -> f64 {
+    dot(n, unit(light).unwrap_or(eye))
+}
+
+/// The angle about the zebra's light tubes (which run along the picture's horizontal) of
+/// the reflection `r = 2(n·e)n − e` of the viewing direction.
+fn zebra_angle(n: Xyz, camera: &Camera) -> f64 {
+    let r = sub(scale(n, 2.0 * dot(n, camera.eye)), camera.eye);
+    dot(r, camera.up).atan2(dot(r, camera.eye))
+}
+
+/// Which of `count` equal bands over `[lo, hi]` holds `x` (bands continue outside).
+fn band_of(x: f64, lo: f64, hi: f64, count: usize) -> i64 {
+    let width = if hi > lo { hi - lo } else { 1.0 } / count.max(1) as f64;
+    ((x - lo) / width).floor() as i64
+}
+
+/// The vertex unit normals of the meshes, turned towards the viewer.
+fn facing_normals<'a>(
+    meshes: &'a [&SurfaceMesh],
+    camera: &'a Camera,
+) -> impl Iterator<Item = Xyz> + 'a {
+    meshes
+        .iter()
+        .flat_map(|m| m.normals.iter())
+        .flatten()
+        .map(|&n| {
+            if dot(n, camera.eye) < 0.0 {
+                scale(n, -1.0)
+            } else {
+                n
+            }
+        })
+}
+
+fn range_of(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+        (lo.min(x), hi.max(x))
+    });
+    if lo <= hi { (lo, hi) } else { (0.0, 0.0) }
+}
+
+/// The range of the brightness `n·light` over the vertices of `meshes` as `camera` sees
+/// them, so that the isophote bands of a gently curved panel spread over what is there
+/// rather than over all of `[−1, 1]`, the same for a before and an after panel.
+pub fn isophote_range(meshes: &[&SurfaceMesh], camera: &Camera, light: Xyz) -> (f64, f64) {
+    range_of(facing_normals(meshes, camera).map(|n| brightness(n, light, camera.eye)))
+}
+
+/// The range of the zebra angle over the vertices of `meshes` (see [`isophote_range`]).
+pub fn zebra_range(meshes: &[&SurfaceMesh], camera: &Camera) -> (f64, f64) {
+    range_of(facing_normals(meshes, camera).map(|n| zebra_angle(n, camera)))
 }
 
 /// The isophote bands' colours: a dark-to-light ramp with a hue that turns, so that
@@ -573,7 +640,9 @@ mod tests {
         let s = bowl(0.0);
         let m = SurfaceMesh::new(&s, &SurfaceMesh::grid(&s));
         let cam = Camera::fit([0.0, 0.0, 1.0], &[&m], 100, 100, 10).unwrap();
-        let r = render(&m, &cam, &Shading::Zebra { stripes: 4 });
+        let (lo, hi) = zebra_range(&[&m], &cam);
+        assert_eq!((lo, hi), (0.0, 0.0));
+        let r = render(&m, &cam, &Shading::Zebra { lo, hi, stripes: 4 });
         // Inside the square [10, 90]²: a plane facing the viewer reflects the viewer's own
         // direction: one stripe, white. Outside: background.
         for (x, y) in [(12, 12), (50, 50), (87, 88)] {
@@ -629,8 +698,16 @@ mod tests {
         let s = bowl(1.0);
         let m = SurfaceMesh::new(&s, &SurfaceMesh::grid(&s));
         let cam = Camera::fit([0.0, 0.0, 1.0], &[&m], 121, 121, 0).unwrap();
+        let light = [0.0, 0.0, 1.0];
+        let (lo, hi) = isophote_range(&[&m], &cam, light);
+        // n·z = 1/sqrt(1 + x² + y²) over [−1, 1]²: from 1/sqrt(3) at the corners to 1 (up
+        // to the interpolant's error).
+        assert!((lo - 1.0 / 3f64.sqrt()).abs() < 1e-2, "{lo}");
+        assert!((hi - 1.0).abs() < 1e-6, "{hi}");
         let shading = Shading::Isophotes {
-            light: [0.0, 0.0, 1.0],
+            light,
+            lo,
+            hi,
             bands: 16,
         };
         let r = render(&m, &cam, &shading);

@@ -233,7 +233,8 @@ impl Fitter {
             }
             abs.sort_by(f64::total_cmp);
             let scale = MAD_TO_SIGMA * abs[abs.len() / 2] * TUKEY_C;
-            if !(scale > 0.0) {
+            // Also stops on NaN.
+            if scale.is_nan() || scale <= 0.0 {
                 break;
             }
             for (k, x) in values.iter().enumerate() {
@@ -254,7 +255,7 @@ impl Fitter {
     /// or the system cannot be solved.
     fn solve(&self, values: &[Option<f64>], weights: &[f64]) -> Option<DVector<f64>> {
         let total: f64 = weights.iter().sum();
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             return None;
         }
         let nv = self.bv.len();
