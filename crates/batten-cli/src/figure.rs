@@ -216,7 +216,7 @@ fn encode_png(r: &Raster, text: &[(&str, &str)]) -> anyhow::Result<Vec<u8>> {
 }
 
 /// RFC 4648 base64 with padding (for the `data:` URIs of the SVG).
-fn base64(bytes: &[u8]) -> String {
+pub(crate) fn base64(bytes: &[u8]) -> String {
     const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut s = String::with_capacity(bytes.len().div_ceil(3) * 4);
     for chunk in bytes.chunks(3) {

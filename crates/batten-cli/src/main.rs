@@ -24,6 +24,7 @@ mod plot;
 mod report;
 mod surface_cmd;
 mod surface_plot;
+mod surface_report;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

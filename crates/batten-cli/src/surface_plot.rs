@@ -135,7 +135,20 @@ pub fn run(args: &PlotSurfaceArgs) -> Result<ExitCode, Failure> {
             Some(f)
         }
     };
-    let figure = draw(args, &before, after.as_ref())?;
+    let views = Views {
+        view: args.view,
+        light: args.light,
+        stripes: args.stripes,
+        width: args.width,
+        height: args.height,
+    };
+    let figure = figure(
+        &args.input.display().to_string(),
+        &before,
+        after.as_ref(),
+        &kinds(args.kind, after.is_some()),
+        &views,
+    )?;
     let bytes = if is_svg(&args.output) {
         figure.svg().map(String::into_bytes)
     } else {
@@ -152,27 +165,24 @@ fn is_svg(p: &std::path::Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("svg"))
 }
 
-/// The rows of the picture.
-fn draw(
-    args: &PlotSurfaceArgs,
-    before: &BSplineSurface,
-    after: Option<&BSplineSurface>,
-) -> Result<Figure, Failure> {
-    let grid = SurfaceMesh::grid(before);
-    let mut meshes = vec![SurfaceMesh::new(before, &grid)];
-    if let Some(a) = after {
-        // The same parameters as the input's mesh, so the deviation compares like with like.
-        meshes.push(SurfaceMesh::new(a, &grid));
-    }
-    let camera = Camera::fit(
-        args.view,
-        &meshes.iter().collect::<Vec<_>>(),
-        args.width,
-        args.height,
-        PANEL_MARGIN,
-    )
-    .map_err(|e| Failure::from_batten("", e))?;
-    let kinds: Vec<SurfaceKind> = match args.kind {
+/// How the views are drawn (the options of `plot-surface` that are not paths).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Views {
+    /// Direction towards the viewer.
+    pub view: Xyz,
+    /// Direction towards the isophotes' light; `None` for the view direction.
+    pub light: Option<Xyz>,
+    /// Isophote bands or zebra stripe pairs.
+    pub stripes: u16,
+    /// One panel's size in pixels.
+    pub width: usize,
+    /// One panel's size in pixels.
+    pub height: usize,
+}
+
+/// The views `kind` stands for (`all`: every one that applies).
+pub(crate) fn kinds(kind: SurfaceKind, faired: bool) -> Vec<SurfaceKind> {
+    match kind {
         SurfaceKind::All => {
             let mut k = vec![
                 SurfaceKind::Gaussian,
@@ -182,21 +192,48 @@ fn draw(
                 SurfaceKind::Isophotes,
                 SurfaceKind::Zebra,
             ];
-            if after.is_some() {
+            if faired {
                 k.push(SurfaceKind::Deviation);
             }
             k
         }
         k => vec![k],
-    };
-    let name = args.input.display().to_string();
+    }
+}
+
+/// The picture: one row per view of `kinds`, the input `before` (named `name` in the
+/// titles) and, if given, the faired surface `after` beside it.
+///
+/// # Errors
+/// A view or picture size the library refuses; `deviation` without `after` (exit 2).
+pub(crate) fn figure(
+    name: &str,
+    before: &BSplineSurface,
+    after: Option<&BSplineSurface>,
+    kinds: &[SurfaceKind],
+    v: &Views,
+) -> Result<Figure, Failure> {
+    let grid = SurfaceMesh::grid(before);
+    let mut meshes = vec![SurfaceMesh::new(before, &grid)];
+    if let Some(a) = after {
+        // The same parameters as the input's mesh, so the deviation compares like with like.
+        meshes.push(SurfaceMesh::new(a, &grid));
+    }
+    let camera = Camera::fit(
+        v.view,
+        &meshes.iter().collect::<Vec<_>>(),
+        v.width,
+        v.height,
+        PANEL_MARGIN,
+    )
+    .map_err(|e| Failure::from_batten("", e))?;
     let sides = if after.is_some() {
         " - before (left), after (right)"
     } else {
         ""
     };
     let mut rows = Vec::new();
-    for kind in kinds {
+    for &kind in kinds {
         let title = format!("{name}: {}{sides}", title(kind));
         let row = match kind {
             SurfaceKind::Gaussian
@@ -242,21 +279,21 @@ fn draw(
                 // Bands over the range seen on both panels, so a gently curved hood shows
                 // as many as a ball and before and after share them.
                 let shading = if kind == SurfaceKind::Isophotes {
-                    let light = args.light.unwrap_or(args.view);
+                    let light = v.light.unwrap_or(v.view);
                     let (lo, hi) =
                         isophote_range(&meshes.iter().collect::<Vec<_>>(), &camera, light);
                     Shading::Isophotes {
                         light,
                         lo,
                         hi,
-                        bands: usize::from(args.stripes),
+                        bands: usize::from(v.stripes),
                     }
                 } else {
                     let (lo, hi) = zebra_range(&meshes.iter().collect::<Vec<_>>(), &camera);
                     Shading::Zebra {
                         lo,
                         hi,
-                        stripes: usize::from(args.stripes),
+                        stripes: usize::from(v.stripes),
                     }
                 };
                 Row {
@@ -295,7 +332,7 @@ fn draw(
     }
     Ok(Figure {
         rows,
-        panel: [args.width, args.height],
+        panel: [v.width, v.height],
     })
 }
 

@@ -375,3 +375,82 @@ fn plot_surface_refuses_bad_requests_without_output() {
     assert!(stderr(&o).contains("zero vector"));
     assert!(!out.exists());
 }
+
+/// A 7 x 7 grid of a gentle bowl with one raised point: a small surface with a defect.
+fn bumpy_grid(path: &Path) {
+    let rows: Vec<String> = (0..7)
+        .map(|i| {
+            let pts: Vec<String> = (0..7)
+                .map(|j| {
+                    let (x, y) = (f64::from(i), f64::from(j));
+                    let bump = if (i, j) == (3, 2) { 0.15 } else { 0.0 };
+                    format!(
+                        "[{x}, {y}, {}]",
+                        0.02 * ((x - 3.0).powi(2) + (y - 3.0).powi(2)) + bump
+                    )
+                })
+                .collect();
+            format!("[{}]", pts.join(", "))
+        })
+        .collect();
+    fs::write(path, format!("{{\"grid\": [{}]}}", rows.join(", "))).unwrap();
+}
+
+#[test]
+fn report_on_a_surface_shows_every_method_before_and_after() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, page) = (dir.path().join("bumpy.json"), dir.path().join("r.html"));
+    bumpy_grid(&input);
+    let o = batten(&["report", s(&input), "-o", s(&page), "--tolerance", "0.2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let html = fs::read_to_string(&page).unwrap();
+    assert!(html.starts_with("<!DOCTYPE html>"));
+    for needle in [
+        "<table class=\"metrics\">",
+        "<table class=\"compare\">",
+        "<h2>salvi</h2>",
+        "<h2>eck-hadenfeld</h2>",
+        "7×7 control points",
+    ] {
+        assert!(html.contains(needle), "{needle} not in the page");
+    }
+    // One picture of the input and one per method, each a PNG that decodes.
+    let prefix = "src=\"data:image/png;base64,";
+    let images: Vec<&str> = html
+        .split(prefix)
+        .skip(1)
+        .map(|rest| &rest[..rest.find('"').unwrap()])
+        .collect();
+    assert_eq!(images.len(), 3);
+    for b64 in images {
+        // The PNG signature, base64-encoded.
+        assert!(b64.starts_with("iVBORw0KGgo"), "{:.20}", b64);
+    }
+    // Both methods met the tolerance: "(met)" twice in the table.
+    assert_eq!(html.matches("(met)").count(), 2, "{html:.3000}");
+}
+
+#[test]
+fn report_on_a_surface_refuses_curve_options_without_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, page) = (dir.path().join("bumpy.json"), dir.path().join("r.html"));
+    bumpy_grid(&input);
+    let cases: [(&[&str], &[&str]); 4] = [
+        (
+            &["--fix-ends"],
+            &["bumpy.json", "--fix-ends and --closed are for curves"],
+        ),
+        (&["--closed"], &["--fix-ends and --closed are for curves"]),
+        (
+            &["--tolerance", "auto"],
+            &["--tolerance auto is for curves"],
+        ),
+        (&["--methods", "han"], &["unknown method 'han'"]),
+    ];
+    for (extra, needles) in cases {
+        let mut args = vec!["report", s(&input), "-o", s(&page)];
+        args.extend_from_slice(extra);
+        assert_usage_error(&batten(&args), needles);
+        assert!(!page.exists());
+    }
+}
