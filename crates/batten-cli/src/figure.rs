@@ -14,7 +14,8 @@ const TITLE_HEIGHT: usize = 24;
 const GAP: usize = 8;
 /// Width of the colour bar itself.
 const BAR_WIDTH: usize = 16;
-/// Width reserved to the right of a row for the bar and its numbers.
+/// Width reserved to the right of the rows for the bars and their numbers (when a row has
+/// one).
 const BAR_AREA: usize = 110;
 /// Pixels per font cell.
 const FONT_SCALE: usize = 2;
@@ -57,8 +58,9 @@ impl Figure {
     fn layout(&self) -> Layout {
         let columns = self.rows.iter().map(|r| r.panels.len()).max().unwrap_or(1);
         let [w, h] = self.panel;
+        let bars = self.rows.iter().any(|r| r.bar.is_some());
         Layout {
-            width: GAP + columns * (w + GAP) + BAR_AREA,
+            width: GAP + columns * (w + GAP) + if bars { BAR_AREA } else { 0 },
             height: GAP + self.rows.len() * (TITLE_HEIGHT + h + GAP),
             columns,
         }
@@ -387,6 +389,16 @@ mod tests {
         // The bar's top is the palette's high end.
         let (bx, by) = fig.bar_at(0, 2);
         assert_eq!(page.pixel(bx + 3, by), Palette::Diverging.colour(1.0));
+        // Without bars, no room is kept for them.
+        let no_bar = Figure {
+            rows: vec![Row {
+                title: "c".into(),
+                panels: vec![Raster::filled(50, 40, [0, 0, 0])],
+                bar: None,
+            }],
+            panel: [50, 40],
+        };
+        assert_eq!(no_bar.raster().width, GAP + 58);
         let svg = fig.svg().unwrap();
         assert_eq!(svg.matches("<image").count(), 4);
         assert!(svg.contains(">-1.00<") && svg.contains(">1.00<"), "{svg}");

@@ -316,6 +316,8 @@ fn plot_surface_draws_before_and_after_as_png_and_svg() {
     assert!(svg.starts_with("<svg"), "{svg:.80}");
     assert_eq!(svg.matches("data:image/png;base64,").count(), 2);
     assert!(svg.contains("zebra - before (left), after (right)"));
+    // No colour bar, so no room kept for one: two 480-pixel panels and the gaps.
+    assert!(svg.contains("width=\"984\""), "{svg:.200}");
     // Deviation: one panel, a bar from 0 to the largest distance.
     let o = batten(&[
         "plot-surface",
