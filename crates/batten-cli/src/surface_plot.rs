@@ -180,6 +180,18 @@ pub(crate) struct Views {
     pub height: usize,
 }
 
+impl Views {
+    /// The defaults of `plot-surface`'s options (kept equal to the clap defaults above; a
+    /// unit test checks).
+    pub const DEFAULT: Views = Views {
+        view: [1.0, -2.0, 3.0],
+        light: None,
+        stripes: 12,
+        width: 480,
+        height: 360,
+    };
+}
+
 /// The views `kind` stands for (`all`: every one that applies).
 pub(crate) fn kinds(kind: SurfaceKind, faired: bool) -> Vec<SurfaceKind> {
     match kind {
@@ -351,6 +363,22 @@ fn title(kind: SurfaceKind) -> &'static str {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_clap_defaults_are_views_default() {
+        use clap::Parser;
+        #[derive(Parser)]
+        struct Cli {
+            #[command(flatten)]
+            args: PlotSurfaceArgs,
+        }
+        let a = Cli::parse_from(["x", "in.json", "-o", "out.png"]).args;
+        let d = Views::DEFAULT;
+        assert_eq!(a.view, d.view);
+        assert_eq!(a.light, d.light);
+        assert_eq!(a.stripes, d.stripes);
+        assert_eq!((a.width, a.height), (d.width, d.height));
+    }
 
     #[test]
     fn directions_parse() {

@@ -114,11 +114,9 @@ pub fn run(args: &SurfaceReportArgs) -> Result<ExitCode, Failure> {
     let s = io::read_surface_json(args.input).map_err(Failure::usage)?;
     let before = analyze_surface(&s);
     let views = Views {
-        view: [1.0, -2.0, 3.0],
-        light: None,
-        stripes: 12,
         width: PANEL[0],
         height: PANEL[1],
+        ..Views::DEFAULT
     };
     let mut runs = Vec::new();
     for &m in &methods {
