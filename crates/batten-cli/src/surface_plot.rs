@@ -19,8 +19,9 @@ use crate::plot::check_output;
 
 /// Free pixels around the surface inside a panel.
 const PANEL_MARGIN: usize = 12;
-/// Smallest and largest panel side, in pixels.
-const PANEL_SIZES: std::ops::RangeInclusive<usize> = 64..=4096;
+/// Smallest and largest panel side, in pixels (a 2048-pixel panel takes about 200 MB of
+/// depth buffer while it is drawn).
+const PANEL_SIZES: std::ops::RangeInclusive<usize> = 64..=2048;
 
 /// What `batten plot-surface` draws.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

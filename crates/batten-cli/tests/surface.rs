@@ -356,7 +356,7 @@ fn plot_surface_refuses_bad_requests_without_output() {
             vec!["--kind", "deviation"],
             &["--kind deviation needs --faired"],
         ),
-        (vec!["--width", "10"], &["--width 10", "64 to 4096"]),
+        (vec!["--width", "10"], &["--width 10", "64 to 2048"]),
         (vec!["--faired", s(&bad)], &["bad.json", "degree_v"]),
         (vec!["--faired", s(&other)], &["other.json", "domain"]),
         (vec!["-o", s(&missing)], &["missing", "does not exist"]),
