@@ -728,6 +728,45 @@ mod tests {
         assert_eq!(r.pixel(60, 60), isophote_colour(15.5 / 16.0));
     }
 
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(24))]
+
+        /// Seen from any side, a flat square covers its projected parallelogram — as many
+        /// pixels as its area, up to the pixels its outline cuts — and reflects the viewer's
+        /// direction everywhere, so the zebra shows one white stripe.
+        #[test]
+        fn a_square_covers_its_projection_from_any_side(
+            x in -1.0f64..1.0, y in -1.0f64..1.0, z in 0.2f64..1.0, flip in proptest::bool::ANY,
+        ) {
+            let s = bowl(0.0);
+            let m = SurfaceMesh::new(&s, &SurfaceMesh::grid(&s));
+            let view = [x, y, if flip { -z } else { z }];
+            let cam = Camera::fit(view, &[&m], 160, 120, 8).unwrap();
+            let (lo, hi) = zebra_range(&[&m], &cam);
+            proptest::prop_assert!((hi - lo).abs() < 1e-9, "{lo} {hi}");
+            let r = render(&m, &cam, &Shading::Zebra { lo, hi, stripes: 6 });
+            let mut covered = 0usize;
+            for py in 0..r.height {
+                for px in 0..r.width {
+                    let c = r.pixel(px, py);
+                    if c != BACKGROUND_RGB {
+                        proptest::prop_assert_eq!(c, [250, 250, 250]);
+                        covered += 1;
+                    }
+                }
+            }
+            let corner = |a: f64, b: f64| cam.project([a, b, 0.0]);
+            let (p0, p1, p3) = (corner(-1.0, -1.0), corner(1.0, -1.0), corner(-1.0, 1.0));
+            let (e1, e2) = ([p1[0] - p0[0], p1[1] - p0[1]], [p3[0] - p0[0], p3[1] - p0[1]]);
+            let area = (e1[0] * e2[1] - e1[1] * e2[0]).abs();
+            let perimeter = 2.0 * (e1[0].hypot(e1[1]) + e2[0].hypot(e2[1]));
+            proptest::prop_assert!(
+                (covered as f64 - area).abs() <= perimeter,
+                "{covered} pixels for an area of {area} (perimeter {perimeter})"
+            );
+        }
+    }
+
     #[test]
     fn palettes_run_from_end_to_end() {
         assert_eq!(Palette::Diverging.colour(0.5), [247, 247, 247]);
