@@ -18,11 +18,10 @@
 //!    point within δ of its **original** position. It is applied inside the objective, so the
 //!    simplex searches the ball `|d − d⁰| ≤ δ` and never proposes a point the clamp would move.
 //! 6. The simplex starts with edge [`SIMPLEX_STEP_REL`] × the mean distance to the
-//!    neighbouring control points. A move is kept only if it lowers Π̂. The run stops when Π̂ is at the rounding floor
-//!    ([`PI_HAT_FLOOR_REL`]), when a window of as
-//!    many moves as there are movable points lowered Π̂ by less than
-//!    [`STALL_REL_IMPROVEMENT`] of its value, or after `max_iterations` moves (default
-//!    [`DEFAULT_MAX_ITERATIONS`]).
+//!    neighbouring control points. A move is kept only if it lowers Π̂. The run stops when Π̂
+//!    is at the rounding floor ([`PI_HAT_FLOOR_REL`]), when a window of as many moves as
+//!    there are movable points lowered Π̂ by less than [`STALL_REL_IMPROVEMENT`] of its
+//!    value, or after `max_iterations` moves (default [`DEFAULT_MAX_ITERATIONS`]).
 //!
 //! Moving `d_ij` changes the homogeneous sums of the samples in its support by
 //! `w_ij N_i^{(a)} N_j^{(b)} Δd` only, so each trial evaluates the curvature at those samples
