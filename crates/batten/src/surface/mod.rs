@@ -39,4 +39,4 @@ pub use sample::{
     MIN_SAMPLES, MinMax, SAMPLES_PER_SPAN, SampleGrid, SurfaceAnalysis, UMBILIC_REL,
     analyze_surface, sample_curvature,
 };
-pub use target::{DEFAULT_SMOOTHING, TARGET_DEGREE, TargetParams, Targets};
+pub use target::{DEFAULT_ROBUST_PASSES, DEFAULT_SMOOTHING, TARGET_DEGREE, TargetParams, Targets};

@@ -6,7 +6,7 @@
 //! 1. The principal curvatures κ1 ≥ κ2 are sampled on a uniform grid
 //!    ([`super::SampleGrid::with_density`], `samples_per_span` per knot span).
 //! 2. The targets g1, g2 are smooth fits of the two fields over the parameter domain with a
-//!    squared roughness penalty ([`super::target`], the spec's reading of eq 17), computed
+//!    squared roughness penalty ([`super::Targets`], the spec's reading of eq 17), computed
 //!    once from the unfaired surface.
 //! 3. The measure is Π̂ = Σ (κ1 − g1)² + (κ2 − g2)² (eq 15).
 //! 4. Each move picks the movable control point with the largest local deviation — the sum

@@ -124,7 +124,7 @@ pub struct SurfaceAnalysis {
     /// Fraction of the regular samples that are umbilics ([`UMBILIC_REL`]).
     pub umbilic_fraction: f64,
     /// Salvi & Várady's Π̂ (eq 15): `Σ (κ1 − g1)² + (κ2 − g2)²` over the regular samples,
-    /// with the default targets g1, g2 of [`super::target`] — how far the principal
+    /// with the default targets g1, g2 ([`super::Targets`]) — how far the principal
     /// curvatures are from smooth versions of themselves. 0 for a sphere or a plane; the
     /// `salvi` fairing lowers it.
     pub fairness_measure: f64,
