@@ -14,7 +14,6 @@ use batten::io;
 use clap::{Args, ValueEnum};
 
 use crate::failure::Failure;
-use crate::input;
 use crate::output;
 
 /// Decimals of the angle as the paper prints it (truncated, not rounded: Table 4).
@@ -72,7 +71,9 @@ pub struct EvaluateArgs {
 /// # Errors
 /// Bad input or options (exit 2); an evaluation that cannot be computed (exit 1).
 pub fn run(args: &EvaluateArgs) -> Result<ExitCode, Failure> {
-    let name = args.input.display().to_string();
+    let name = crate::formats::display_name(&args.input)
+        .display()
+        .to_string();
     let mut opts = KuraganoOptions::default()
         .with_residual(match args.residual {
             ResidualArg::Rho => Residual::Rho,
@@ -91,15 +92,13 @@ pub fn run(args: &EvaluateArgs) -> Result<ExitCode, Failure> {
         opts = opts.with_rho_max(r);
     }
     let what = format!("{name}: cannot evaluate");
-    // A JSON file may hold a B-spline curve; anything else is a point list.
-    let curve = match io::Format::from_path(&args.input) {
-        Ok(io::Format::Json) => io::read_curve_json(&args.input).ok(),
-        _ => None,
-    };
-    let evaluation = match &curve {
-        Some(c) => kuragano::evaluate(c, &opts),
-        None => {
-            let data = input::read(&args.input, false)?;
+    // A B-spline (JSON, DXF SPLINE, IGES 126, SVG Béziers) or a point list.
+    let format = crate::formats::format_of(&args.input, None)?;
+    let source =
+        crate::formats::read_input(&args.input, format, false, &io::Pick::default())?.source;
+    let evaluation = match source {
+        io::Source::Curve(c) => kuragano::evaluate(&c, &opts),
+        io::Source::Points(data) => {
             if data.seq.is_closed() {
                 return Err(Failure::usage(anyhow!(
                     "{name}: the fairness evaluation needs an open curve"

@@ -5,14 +5,14 @@ use std::process::ExitCode;
 
 use anyhow::anyhow;
 use batten::fair::{self, FairReport};
-use batten::io::{self, Format, IoError, PointData, ReadOptions, format_f64};
+use batten::io::{self, Format, IoError, PointData, format_f64};
 use batten::spline::BSplineCurve;
 use batten::{Faired, PointSeq, analysis};
 
 use crate::FairArgs;
 use crate::failure::{EXIT_FAILED, Failure};
-use crate::input;
 use crate::output::{self, sig};
+use crate::{formats, input};
 
 /// Significant digits in the summary line.
 const DIGITS: usize = 4;
@@ -36,54 +36,66 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         params,
     );
     input::check(method, args.closed, &options)?;
-    Format::from_path(&args.output).map_err(Failure::usage)?;
-    check_directory(&args.output)?;
+    let in_format = formats::format_of(&args.input, args.pick.format)?;
+    let out_format = formats::format_of(&args.output, args.pick.format)?;
+    let input_name = formats::display_name(&args.input);
+    args.pick
+        .check(in_format, &input_name.display().to_string())?;
+    let to_stdout = formats::is_stdio(&args.output);
+    if !to_stdout {
+        check_directory(&args.output)?;
+    }
     if let Some(report) = &args.report {
         check_directory(report)?;
     }
+    let curve_format = match &args.curve_out {
+        None => None,
+        Some(curve_out) => {
+            let f = Format::from_path(curve_out)
+                .ok()
+                .filter(|f| *f != Format::Text);
+            let Some(f) = f else {
+                return Err(Failure::usage(anyhow!(
+                    "{}: --curve-out writes a B-spline: give a .json, .dxf, .igs or .svg file",
+                    curve_out.display()
+                )));
+            };
+            check_directory(curve_out)?;
+            if !formats::is_stdio(&args.input) {
+                io::ensure_distinct(&args.input, curve_out).map_err(Failure::usage)?;
+            }
+            let clash = same_path(curve_out, &args.output)
+                || args
+                    .report
+                    .as_deref()
+                    .is_some_and(|r| same_path(curve_out, r));
+            if clash {
+                return Err(Failure::usage(anyhow!(
+                    "--curve-out {} names another output too",
+                    curve_out.display()
+                )));
+            }
+            Some(f)
+        }
+    };
 
-    if let Some(curve_out) = &args.curve_out {
-        if !matches!(Format::from_path(curve_out), Ok(Format::Json)) {
-            return Err(Failure::usage(anyhow!(
-                "{}: --curve-out writes a B-spline as JSON: give a .json file",
-                curve_out.display()
-            )));
-        }
-        check_directory(curve_out)?;
-        io::ensure_distinct(&args.input, curve_out).map_err(Failure::usage)?;
-        let clash = same_path(curve_out, &args.output)
-            || args
-                .report
-                .as_deref()
-                .is_some_and(|r| same_path(curve_out, r));
-        if clash {
-            return Err(Failure::usage(anyhow!(
-                "--curve-out {} names another output too",
-                curve_out.display()
-            )));
-        }
-    }
-
-    // A B-spline JSON file is faired as a curve (control-point methods only).
-    let source = match io::read_points(
-        &args.input,
-        &ReadOptions::default().with_closed(args.closed),
-    ) {
-        Ok(data) => Source::Points(data),
-        Err(IoError::CurveNotPoints { .. }) => {
-            Source::Curve(io::read_curve_json(&args.input).map_err(Failure::usage)?)
-        }
-        Err(e) => return Err(Failure::usage(e)),
+    // A B-spline (JSON, DXF SPLINE, IGES 126, SVG Béziers) is faired as a curve
+    // (control-point methods only).
+    let read = formats::read_input(&args.input, in_format, args.closed, &args.pick.pick())?;
+    let origin = read.origin;
+    let source = match read.source {
+        io::Source::Points(d) => Source::Points(d),
+        io::Source::Curve(c) => Source::Curve(c),
     };
     match &source {
         // A JSON file can make the curve closed: check the method against that too.
         Source::Points(d) => fair::check_options(method, d.seq.is_closed(), &options)
-            .map_err(|e| Failure::from_batten(&args.input.display().to_string(), e))?,
+            .map_err(|e| Failure::from_batten(&input_name.display().to_string(), e))?,
         Source::Curve(_) if !method.run_curve_supported() => {
             return Err(Failure::usage(anyhow!(
                 "{}; method {} takes points (B-spline input: {})",
                 IoError::CurveNotPoints {
-                    path: args.input.clone()
+                    path: input_name.clone()
                 },
                 method.name(),
                 fair::methods()
@@ -96,9 +108,13 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         }
         Source::Curve(_) => {}
     }
-    io::ensure_distinct(&args.input, &args.output).map_err(Failure::usage)?;
+    if !formats::is_stdio(&args.input) && !to_stdout {
+        io::ensure_distinct(&args.input, &args.output).map_err(Failure::usage)?;
+    }
     if let Some(report) = &args.report {
-        io::ensure_distinct(&args.input, report).map_err(Failure::usage)?;
+        if !formats::is_stdio(&args.input) {
+            io::ensure_distinct(&args.input, report).map_err(Failure::usage)?;
+        }
         if same_path(report, &args.output) {
             return Err(Failure::usage(anyhow!(
                 "--report and --output both name {}",
@@ -107,7 +123,7 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         }
     }
 
-    let input_name = args.input.display();
+    let input_name = input_name.display();
     let failed =
         |e| Failure::from_batten(&format!("{input_name}: method {} failed", method.name()), e);
     let faired = match &source {
@@ -125,12 +141,28 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         .tangents
         .as_deref()
         .or(data.and_then(|d| d.tangents.as_deref()));
-    io::write_points(&args.output, &faired.points, closed, tangents).map_err(Failure::failed)?;
+    let out_name = formats::display_name(&args.output);
+    let bytes = match (out_format, faired.curve.as_ref()) {
+        // SVG holds the faired B-spline itself when it can (a method's cubic).
+        (Format::Svg, Some(c)) if io::svg_can_hold(c) => {
+            io::format_curve(out_format, &out_name, c, closed, &origin)
+        }
+        _ => io::format_points(
+            out_format,
+            &out_name,
+            &faired.points,
+            closed,
+            tangents,
+            &origin,
+        ),
+    }
+    .map_err(Failure::failed)?;
+    formats::write_output(&args.output, &bytes)?;
     if let Some(path) = &args.report {
         write_report(path, &faired.report)?;
     }
-    if let Some(path) = &args.curve_out {
-        write_curve(path, &faired, closed)?;
+    if let (Some(path), Some(format)) = (&args.curve_out, curve_format) {
+        write_curve(path, format, &faired, closed, &origin)?;
     }
 
     output::note(&summary(&faired.report, data));
@@ -180,9 +212,16 @@ enum Source {
     Curve(BSplineCurve),
 }
 
-/// Write the faired curve as B-spline JSON, atomically: the method's own B-spline, or the
-/// analysis curve (the C² cubic through the faired points) converted exactly to B-spline form.
-fn write_curve(path: &Path, faired: &Faired, closed: bool) -> Result<(), Failure> {
+/// Write the faired curve (JSON, DXF SPLINE, IGES 126 or SVG), atomically: the method's own
+/// B-spline, or the analysis curve (the C² cubic through the faired points) converted
+/// exactly to B-spline form.
+fn write_curve(
+    path: &Path,
+    format: Format,
+    faired: &Faired,
+    closed: bool,
+    origin: &io::Origin,
+) -> Result<(), Failure> {
     let converted;
     let curve = match &faired.curve {
         Some(c) => c,
@@ -197,10 +236,16 @@ fn write_curve(path: &Path, faired: &Faired, closed: bool) -> Result<(), Failure
             &converted
         }
     };
-    let mut json = serde_json::to_string_pretty(curve)
-        .map_err(|e| Failure::failed(anyhow!("cannot encode the curve: {e}")))?;
-    json.push('\n');
-    io::write_atomic(path, json.as_bytes()).map_err(Failure::failed)
+    let bytes = match io::format_curve(format, path, curve, closed, origin) {
+        Ok(b) => b,
+        // SVG holds Béziers of degree 3 at most: the C² cubic through the faired points.
+        Err(_) if format == Format::Svg => {
+            io::format_points(format, path, &faired.points, closed, None, origin)
+                .map_err(Failure::failed)?
+        }
+        Err(e) => return Err(Failure::failed(e)),
+    };
+    io::write_atomic(path, &bytes).map_err(Failure::failed)
 }
 
 /// Write the report as pretty JSON, atomically.

@@ -17,6 +17,7 @@ mod evaluate;
 mod failure;
 mod fair_cmd;
 mod figure;
+mod formats;
 mod input;
 mod methods;
 mod output;
@@ -74,7 +75,7 @@ enum Command {
 /// Arguments of `batten analyze`.
 #[derive(Debug, Args)]
 struct AnalyzeArgs {
-    /// Point file (.csv, .txt or .json)
+    /// Point file (.csv, .txt, .json, .dxf, .igs, .svg; `-` reads standard input)
     #[arg(value_name = "INPUT")]
     input: PathBuf,
     /// Print a JSON object instead of a table
@@ -83,17 +84,20 @@ struct AnalyzeArgs {
     /// The points form a closed curve (the last connects to the first; do not repeat it)
     #[arg(long)]
     closed: bool,
+    #[command(flatten)]
+    pick: formats::PickArgs,
 }
 
 /// Arguments of `batten fair`.
 #[derive(Debug, Args)]
 struct FairArgs {
-    /// Point file (.csv, .txt or .json), or a B-spline curve as JSON ({"degree", "knots",
-    /// "control_points", "weights"}) for the methods that work on control points
+    /// Point file (.csv, .txt, .json, .dxf, .igs, .svg; `-` reads standard input), or a
+    /// B-spline (JSON {"degree", "knots", "control_points", "weights"}, a DXF SPLINE, IGES
+    /// entity 126, SVG Béziers) for the methods that work on control points
     #[arg(value_name = "INPUT")]
     input: PathBuf,
-    /// Where to write the faired points; the format follows the extension (.csv, .txt, .json).
-    /// Never the input file
+    /// Where to write the faired points; the format follows the extension (.csv, .txt, .json,
+    /// .dxf, .igs, .svg); `-` writes standard output. Never the input file
     #[arg(short, long, value_name = "OUTPUT")]
     output: PathBuf,
     /// Fairing method (see `batten methods`) [default: the first listed there]
@@ -114,9 +118,10 @@ struct FairArgs {
     /// Write the fairing report (JSON) to this file
     #[arg(long, value_name = "R.json")]
     report: Option<PathBuf>,
-    /// Also write the faired curve as a B-spline (JSON: degree, knots, control_points): the
-    /// method's own curve, or the C² cubic through the faired points for point methods
-    #[arg(long, value_name = "FILE.json")]
+    /// Also write the faired curve as a B-spline (.json: degree, knots, control_points; .dxf:
+    /// SPLINE; .igs: entity 126; .svg: Bézier path): the method's own curve, or the C² cubic
+    /// through the faired points for point methods
+    #[arg(long, value_name = "FILE")]
     curve_out: Option<PathBuf>,
     /// A method parameter, KEY=VALUE (repeat for several; see `batten methods`)
     #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -124,6 +129,8 @@ struct FairArgs {
     /// The points form a closed curve (a JSON file can say so with "closed": true)
     #[arg(long)]
     closed: bool,
+    #[command(flatten)]
+    pick: formats::PickArgs,
 }
 
 /// Output format of `batten compare`.

@@ -81,7 +81,9 @@ pub fn run(args: &ReportArgs) -> Result<ExitCode, Failure> {
     base.validate().map_err(|e| Failure::from_batten("", e))?;
     check_output(&args.output, &["html", "htm"], &[args.input.as_path()])?;
     let data = input::read(&args.input, args.closed)?;
-    let name = args.input.display().to_string();
+    let name = crate::formats::display_name(&args.input)
+        .display()
+        .to_string();
     let before = FairnessMetrics::of_seq(&data.seq)
         .map_err(|e| Failure::from_batten(&format!("{name}: cannot analyse"), e))?;
 

@@ -14,7 +14,7 @@
 //! (the bundled `sine-noisy.csv`, noise in y: 0.0045 against a true 0.03); projected on the
 //! normal it gives 0.033. See `docs/algorithms/band.md`.
 
-use crate::geom::Point;
+use crate::geom::{Point, Vec2};
 
 /// The MAD-to-σ factor for Gaussian noise.
 pub const MAD_TO_SIGMA: f64 = 1.482_6;
@@ -22,33 +22,77 @@ pub const MAD_TO_SIGMA: f64 = 1.482_6;
 /// The standard deviation of a third difference of unit-variance independent noise: √20.
 const THIRD_DIFFERENCE_GAIN: f64 = 4.472_135_954_999_579;
 
+/// How long the chord that gives the local normal must be, in units of a rough noise scale:
+/// where the noise is as large as the point spacing (dense scans), the chord over four points
+/// points anywhere, and the projection would hide the noise. The chord is widened
+/// symmetrically until it spans about this many rough noise scales.
+const NORMAL_CHORD_NOISE_SPANS: f64 = 20.0;
+
 /// The noise estimate σ̂ of the points `pts` (per coordinate, in data units), from the third
 /// differences along the local normal. Closed curves wrap around. Returns 0 for fewer than
-/// four points (open) or where every normal component vanishes (points on a line, exact
-/// samples of a polynomial of degree two or less).
+/// four points or where every normal component vanishes (points on a line, exact samples of
+/// a parabola).
+///
+/// The normal at a third difference `p_i … p_{i+3}` is that of the chord `p_{i+3+m} −
+/// p_{i−m}` (indices clamped at the ends of an open curve), with `m = 0` unless the noise is
+/// comparable to the point spacing: `m` is chosen so the chord spans about
+/// [`NORMAL_CHORD_NOISE_SPANS`] times a rough noise scale (the same MAD taken over the whole
+/// third-difference vectors, an overestimate) — at most an eighth of the points.
 pub fn noise_sigma(pts: &[Point], closed: bool) -> f64 {
     let n = pts.len();
     if n < 4 {
         return 0.0;
     }
     let count = if closed { n } else { n - 3 };
-    let at = |i: usize| pts[i % n];
-    let mut normal_parts: Vec<f64> = (0..count)
+    let at = |i: isize| -> Point {
+        if closed {
+            pts[i.rem_euclid(n as isize) as usize]
+        } else {
+            pts[i.clamp(0, n as isize - 1) as usize]
+        }
+    };
+    let third = |i: usize| -> Vec2 {
+        let i = i as isize;
+        let (p0, p1, p2, p3) = (at(i), at(i + 1), at(i + 2), at(i + 3));
+        Vec2::new(
+            p3.x - 3.0 * p2.x + 3.0 * p1.x - p0.x,
+            p3.y - 3.0 * p2.y + 3.0 * p1.y - p0.y,
+        )
+    };
+    let rough = median((0..count).map(|i| third(i).length()).collect()) * MAD_TO_SIGMA
+        / THIRD_DIFFERENCE_GAIN;
+    let spacing = median(
+        (0..if closed { n } else { n - 1 })
+            .map(|i| (at(i as isize + 1) - at(i as isize)).length())
+            .collect(),
+    );
+    let reach = if spacing > 0.0 {
+        let m = (NORMAL_CHORD_NOISE_SPANS * rough / spacing).ceil();
+        if m.is_finite() {
+            (m as usize).min(n / 8)
+        } else {
+            0
+        }
+    } else {
+        0
+    };
+    let normal_parts: Vec<f64> = (0..count)
         .filter_map(|i| {
-            let (p0, p1, p2, p3) = (at(i), at(i + 1), at(i + 2), at(i + 3));
-            let d3x = p3.x - 3.0 * p2.x + 3.0 * p1.x - p0.x;
-            let d3y = p3.y - 3.0 * p2.y + 3.0 * p1.y - p0.y;
-            let chord = p3 - p0;
+            let chord = at(i as isize + 3 + reach as isize) - at(i as isize - reach as isize);
             let len = chord.length();
-            (len > 0.0).then(|| ((-chord.y * d3x + chord.x * d3y) / len).abs())
+            (len > 0.0).then(|| third(i).cross(chord).abs() / len)
         })
         .collect();
-    if normal_parts.is_empty() {
+    MAD_TO_SIGMA * median(normal_parts) / THIRD_DIFFERENCE_GAIN
+}
+
+/// The median of `v` (the upper one for an even count; 0 when empty).
+fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
         return 0.0;
     }
-    let mid = normal_parts.len() / 2;
-    let (_, m, _) = normal_parts.select_nth_unstable_by(mid, f64::total_cmp);
-    MAD_TO_SIGMA * *m / THIRD_DIFFERENCE_GAIN
+    let mid = v.len() / 2;
+    *v.select_nth_unstable_by(mid, f64::total_cmp).1
 }
 
 #[cfg(test)]
@@ -87,14 +131,16 @@ mod tests {
 
     #[test]
     fn recovers_noise_in_one_coordinate() {
-        // A sine sampled at 2000 points with noise of 0.03 in y only: the estimate is within
-        // 10 % of the truth (a pooled MAD would give about a third of it).
+        // A shallow sine sampled at 2000 points, closer than the noise (0.005 against 0.03),
+        // with noise in y only: the estimate is within 10 % of the truth (a pooled MAD gives
+        // about a third of it). The estimate is of the noise along the normal, so the sine is
+        // shallow (slope at most 0.2), where the normal is nearly y.
         let sigma = 0.03;
         let e = gaussian(7, 2000);
         let pts: Vec<Point> = (0..2000)
             .map(|i| {
                 let x = i as f64 * 0.005;
-                Point::new(x, x.sin() + sigma * e[i])
+                Point::new(x, 0.2 * x.sin() + sigma * e[i])
             })
             .collect();
         let est = noise_sigma(&pts, false);

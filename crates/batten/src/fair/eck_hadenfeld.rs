@@ -674,6 +674,7 @@ fn outcome(
     insert_common(&mut parameters, &report);
     notes.extend(report.notes);
     Outcome {
+        solver: None,
         points,
         status: report.status,
         iterations: report.iterations,

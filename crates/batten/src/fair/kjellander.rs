@@ -1094,6 +1094,7 @@ fn run_points(
     }
     parameters.insert("solve_half_width".into(), json!(SOLVE_HALF_WIDTH));
     Ok(Outcome {
+        solver: None,
         points: state.r,
         status: driven.status,
         iterations: driven.moves.len(),
@@ -1252,6 +1253,7 @@ pub fn fair_hermite(
     let driven = drive(&mut state, threshold, max_moves, options.tolerance)?;
     let parameters = driven_parameters(&driven, threshold, max_moves);
     Ok(Outcome {
+        solver: None,
         points: state.r,
         status: driven.status,
         iterations: driven.moves.len(),

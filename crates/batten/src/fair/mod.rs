@@ -10,6 +10,7 @@
 //! Adding a method: implement [`FairMethod`] in a file of its own under `fair/` and list it
 //! in [`methods`].
 
+pub mod band;
 pub mod cali;
 pub mod eck_hadenfeld;
 pub mod han;
@@ -24,6 +25,7 @@ pub mod smoothing;
 
 use std::time::Instant;
 
+pub use band::Band;
 pub use cali::Cali;
 pub use eck_hadenfeld::EckHadenfeld;
 pub use han::Han;
@@ -31,7 +33,9 @@ pub use kjellander::{
     Energy, HermiteMove, Kjellander, KpRule, Poliakoff, fair_hermite, hermite_step,
 };
 pub use options::{AUTO_TOLERANCE_K, EndFix, FairOptions, ParamSpec};
-pub use report::{EndChanges, FairReport, FairStatus, HistoryRow, Move, ToleranceSource};
+pub use report::{
+    EndChanges, FairReport, FairStatus, HistoryRow, Move, SolverInfo, ToleranceSource,
+};
 pub use salvi::Salvi;
 pub use sapidis_farin::{SapidisFarin, remove_reinsert_knot};
 pub use smoothing::{Mst, Smoothing, SmoothingInfo, SmoothingSpline, SmoothingTrial};
@@ -62,6 +66,8 @@ pub struct Outcome {
     pub curve: Option<BSplineCurve>,
     /// Updated tangents, for methods that carry tangents (Hermite data).
     pub tangents: Option<Vec<Vec2>>,
+    /// The solver's figures, for methods that solve an optimisation problem.
+    pub solver: Option<SolverInfo>,
 }
 
 /// A fairing method. Implementations are stateless unit structs.
@@ -137,6 +143,7 @@ pub struct Faired {
     pub tangents: Option<Vec<Vec2>>,
 }
 
+static BAND: Band = Band;
 static MST: Mst = Mst;
 static CALI: Cali = Cali;
 static HAN: Han = Han;
@@ -154,6 +161,7 @@ static KURAGANO: kuragano::Kuragano = kuragano::Kuragano;
 /// becomes the default.
 static REGISTRY: &[&dyn FairMethod] = &[
     &HAN,
+    &BAND,
     &MST,
     &CALI,
     &SALVI,
@@ -428,6 +436,7 @@ fn finish(
         elapsed_seconds: elapsed.as_secs_f64(),
         parameters: outcome.parameters,
         history: outcome.history,
+        solver: outcome.solver,
         notes,
     };
     Ok(Faired {

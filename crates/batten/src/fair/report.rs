@@ -33,6 +33,18 @@ pub enum ToleranceSource {
     Auto,
 }
 
+/// What an optimisation-based method's solver did (`band`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct SolverInfo {
+    /// Interior-point iterations, over all passes.
+    pub iterations: usize,
+    /// The final surrogate duality gap, relative to the objective (or to 1).
+    pub duality_gap: f64,
+    /// Points whose displacement is within 0.01 % of the tolerance: where the band, not
+    /// the energy, decided.
+    pub points_on_band_edge: usize,
+}
+
 /// One point move of a local method.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Move {
@@ -119,6 +131,8 @@ pub struct FairReport {
     pub parameters: serde_json::Map<String, serde_json::Value>,
     /// Per-iteration trace.
     pub history: Vec<HistoryRow>,
+    /// The solver's figures, for methods that solve an optimisation problem (`band`).
+    pub solver: Option<SolverInfo>,
     /// Remarks for the user.
     pub notes: Vec<String>,
 }

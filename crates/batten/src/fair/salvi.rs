@@ -927,6 +927,7 @@ fn run_fitted(
     let mut notes = fitted.notes;
     notes.extend(report.local.notes);
     Ok(Outcome {
+        solver: None,
         points,
         status: report.local.status,
         iterations: report.local.iterations,

@@ -504,6 +504,7 @@ impl FairMethod for SapidisFarin {
         );
         let points = state.output(&initial)?;
         Ok(Outcome {
+            solver: None,
             points,
             status: driven.status,
             iterations: driven.moves.len(),

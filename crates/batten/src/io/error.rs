@@ -32,7 +32,10 @@ pub enum IoError {
         source: std::io::Error,
     },
     /// The file name's extension names no supported format.
-    #[error("{}: unknown file format (use a .csv, .txt or .json file name)", path.display())]
+    #[error(
+        "{}: unknown file format (use a .csv, .txt, .json, .dxf, .igs/.iges or .svg file name)",
+        path.display()
+    )]
     UnknownFormat {
         /// The file.
         path: PathBuf,
@@ -143,6 +146,18 @@ pub enum IoError {
         /// What is wrong.
         message: String,
     },
+    /// A DXF, IGES or SVG file is malformed, holds something batten does not take (a 3-D
+    /// curve, an arc, a transform), or does not say which of its curves to take. `message`
+    /// names the entity (DXF handle, IGES directory entry, SVG element) where there is one.
+    #[error("{}{at}: {message}", path.display())]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// Where in the file, as far as the format can tell.
+        at: Location,
+        /// What is wrong.
+        message: String,
+    },
     /// A JSON point list whose `tangents` array has a different length than `points`.
     #[error("{}: {got} tangents for {expected} points", path.display())]
     TangentCount {
@@ -197,4 +212,43 @@ pub enum IoError {
         /// The output path as given.
         output: PathBuf,
     },
+}
+
+/// A place in a file, for [`IoError::Format`]: displayed as nothing, `:LINE` or
+/// `:LINE:COLUMN` after the file name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Location {
+    /// The file as a whole (the message names the entity).
+    File,
+    /// A 1-based line.
+    Line(usize),
+    /// A 1-based line and column.
+    LineColumn(usize, usize),
+}
+
+impl std::fmt::Display for Location {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Location::File => Ok(()),
+            Location::Line(l) => write!(f, ":{l}"),
+            Location::LineColumn(l, c) => write!(f, ":{l}:{c}"),
+        }
+    }
+}
+
+/// A message from another crate on one line: control characters (a newline it quotes from
+/// the file) written as escapes.
+pub(crate) fn one_line(message: &str) -> String {
+    message
+        .chars()
+        .flat_map(|c| {
+            let escaped: Vec<char> = if c.is_control() {
+                c.escape_default().collect()
+            } else {
+                vec![c]
+            };
+            escaped
+        })
+        .collect()
 }
