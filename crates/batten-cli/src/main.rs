@@ -16,12 +16,16 @@ mod compare;
 mod evaluate;
 mod failure;
 mod fair_cmd;
+mod figure;
 mod formats;
 mod input;
 mod methods;
 mod output;
 mod plot;
 mod report;
+mod surface_cmd;
+mod surface_plot;
+mod surface_report;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -61,6 +65,12 @@ enum Command {
     Batch(batch::BatchArgs),
     /// Kuragano & Yamaguchi's fairness evaluation: which polynomial ρ(s) the curve follows best
     Evaluate(evaluate::EvaluateArgs),
+    /// Curvature ranges, umbilics and the fairness measure of a B-spline surface (JSON)
+    AnalyzeSurface(surface_cmd::AnalyzeSurfaceArgs),
+    /// Fair a B-spline surface (JSON) within a tolerance: salvi or eck-hadenfeld
+    FairSurface(surface_cmd::FairSurfaceArgs),
+    /// Curvature maps, isophotes, zebra and deviation of a B-spline surface (PNG or SVG)
+    PlotSurface(surface_plot::PlotSurfaceArgs),
 }
 
 /// Arguments of `batten analyze`.
@@ -189,6 +199,9 @@ fn main() -> ExitCode {
         Command::Report(a) => report::run(&a),
         Command::Batch(a) => batch::run(&a),
         Command::Evaluate(a) => evaluate::run(&a),
+        Command::AnalyzeSurface(a) => surface_cmd::analyze(&a),
+        Command::FairSurface(a) => surface_cmd::fair(&a),
+        Command::PlotSurface(a) => surface_plot::run(&a),
     };
     match result {
         Ok(code) => code,

@@ -69,6 +69,7 @@ mod dxf;
 mod error;
 mod iges;
 mod json;
+mod surface;
 mod svg;
 mod text;
 
@@ -79,6 +80,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 pub use dxf::{DxfCurve, DxfDrawing, DxfGeometry};
 pub use error::{IoError, Location};
+pub use surface::{format_surface, parse_surface, read_surface_json, write_surface_json};
 pub use text::format_f64;
 
 use crate::error::Error;
