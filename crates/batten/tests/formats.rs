@@ -263,7 +263,10 @@ fn ezdxf_entities_read_as_ezdxf_was_given() {
         let r = io::read_input(&path, None, &ReadOptions::default(), &pick);
         if e.get("refused").is_some() {
             let m = r.unwrap_err().to_string();
-            assert!(m.contains(&format!("POLYLINE {handle} on layer SPACE: z varies")), "{m}");
+            assert!(
+                m.contains(&format!("POLYLINE {handle} on layer SPACE: z varies")),
+                "{m}"
+            );
             continue;
         }
         let input = r.unwrap();
@@ -273,7 +276,11 @@ fn ezdxf_entities_read_as_ezdxf_was_given() {
         match input.source {
             Source::Points(d) => {
                 assert_eq!(d.seq.points(), &pairs(&e["points"])[..], "{handle}");
-                assert_eq!(d.seq.is_closed(), e["closed"].as_bool().unwrap(), "{handle}");
+                assert_eq!(
+                    d.seq.is_closed(),
+                    e["closed"].as_bool().unwrap(),
+                    "{handle}"
+                );
             }
             Source::Curve(c) => {
                 assert_eq!(c.degree() as u64, e["degree"].as_u64().unwrap());
