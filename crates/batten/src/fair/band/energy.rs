@@ -22,7 +22,7 @@
 
 /// The shortest parameter step, relative to the mean chord: points of an iterate that (nearly)
 /// coincide would give divided differences of unbounded size.
-pub(super) const CHORD_FLOOR_REL: f64 = 1e-3;
+pub(super) const CHORD_FLOOR_REL: f64 = 0.1;
 
 /// One window of four consecutive points.
 #[derive(Clone, Copy, Debug)]
