@@ -21,7 +21,6 @@ use std::ffi::OsString;
 use std::fmt::Write as _;
 use std::fs;
 use std::io::IsTerminal as _;
-use std::num::NonZeroUsize;
 use std::panic::{self, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -42,6 +41,15 @@ use crate::{fair_cmd, input};
 
 /// Significant digits of displacements in messages.
 const DIGITS: usize = 4;
+
+/// Most files faired at once (`--jobs`): each is a thread with its own curve in memory, and
+/// thousands of threads only cost time to start (30000 took minutes for one file).
+const MAX_JOBS: usize = 1024;
+
+/// `--jobs N` (clap value parser): 1 to [`MAX_JOBS`].
+fn parse_jobs(s: &str) -> Result<usize, String> {
+    input::parse_count(s, MAX_JOBS)
+}
 
 /// Suffix of the report written beside each output: `NAME.csv` → `NAME.report.json`.
 const REPORT_SUFFIX: &str = ".report.json";
@@ -69,8 +77,9 @@ pub struct BatchArgs {
     #[arg(long, value_name = "WHAT", num_args = 0..=1, require_equals = true,
           default_missing_value = "position", value_parser = input::parse_end_fix)]
     fix_ends: Option<EndFix>,
-    /// Upper bound on the method's iterations (its own unit: sweeps, moves or passes)
-    #[arg(long, value_name = "N")]
+    /// Upper bound on the method's iterations (its own unit: sweeps, moves or passes), 1 to
+    /// 1000000
+    #[arg(long, value_name = "N", value_parser = input::parse_max_iterations)]
     max_iterations: Option<usize>,
     /// A method parameter, KEY=VALUE (repeat for several; see `batten methods`)
     #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -79,10 +88,10 @@ pub struct BatchArgs {
     /// displacements, metrics before and after) to this .json or .csv file
     #[arg(long, value_name = "FILE")]
     summary: Option<PathBuf>,
-    /// Files faired at once [default: one per core; more can help where writes wait for a
-    /// slow disk, as every file is synced]
-    #[arg(long, value_name = "N")]
-    jobs: Option<NonZeroUsize>,
+    /// Files faired at once, 1 to 1024 and never more than the files [default: one per core;
+    /// more can help where writes wait for a slow disk, as every file is synced]
+    #[arg(long, value_name = "N", value_parser = parse_jobs)]
+    jobs: Option<usize>,
 }
 
 /// How one input ended.
@@ -220,7 +229,8 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
     })?;
 
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.jobs.map_or(0, NonZeroUsize::get))
+        // More threads than files would only idle.
+        .num_threads(args.jobs.map_or(0, |n| n.min(jobs.len())))
         .build()
         .map_err(|e| Failure::failed(anyhow!("cannot start worker threads: {e}")))?;
     let bar = progress_bar(jobs.len());

@@ -21,6 +21,7 @@ mod methods;
 mod output;
 mod plot;
 mod report;
+mod usage;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -98,8 +99,9 @@ struct FairArgs {
     #[arg(long, value_name = "WHAT", num_args = 0..=1, require_equals = true,
           default_missing_value = "position", value_parser = input::parse_end_fix)]
     fix_ends: Option<EndFix>,
-    /// Upper bound on the method's iterations (its own unit: sweeps, moves or passes)
-    #[arg(long, value_name = "N")]
+    /// Upper bound on the method's iterations (its own unit: sweeps, moves or passes), 1 to
+    /// 1000000
+    #[arg(long, value_name = "N", value_parser = input::parse_max_iterations)]
     max_iterations: Option<usize>,
     /// Write the fairing report (JSON) to this file
     #[arg(long, value_name = "R.json")]
@@ -155,7 +157,19 @@ struct CompareArgs {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let argv: Vec<String> = std::env::args_os()
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => match usage::classify(e, &argv) {
+            usage::ClapOutcome::Print(e) => e.exit(),
+            usage::ClapOutcome::Usage(message) => {
+                output::error_line(&message);
+                return ExitCode::from(failure::EXIT_USAGE);
+            }
+        },
+    };
     let result = match cli.command {
         Command::Analyze(a) => analyze::run(&a),
         Command::Fair(a) => fair_cmd::run(&a),

@@ -30,7 +30,7 @@ pub use han::Han;
 pub use kjellander::{
     Energy, HermiteMove, Kjellander, KpRule, Poliakoff, fair_hermite, hermite_step,
 };
-pub use options::{AUTO_TOLERANCE_K, EndFix, FairOptions, ParamSpec};
+pub use options::{AUTO_TOLERANCE_K, EndFix, FairOptions, MAX_ITERATIONS, ParamSpec};
 pub use report::{EndChanges, FairReport, FairStatus, HistoryRow, Move, ToleranceSource};
 pub use salvi::Salvi;
 pub use sapidis_farin::{SapidisFarin, remove_reinsert_knot};

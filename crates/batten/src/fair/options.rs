@@ -90,6 +90,12 @@ impl FromStr for EndFix {
 /// coordinate.
 pub const AUTO_TOLERANCE_K: f64 = 3.0;
 
+/// Largest iteration limit accepted ([`FairOptions::max_iterations`]). Every method's
+/// iteration costs at least one pass over its curve, and the per-iteration history of the
+/// report grows with the count: at this bound a 30-point `kjellander` run takes about 6 s
+/// and 70 MB, and larger limits only let a run go on for minutes and gigabytes.
+pub const MAX_ITERATIONS: usize = 1_000_000;
+
 /// Options common to every fairing method, plus the method's own parameters.
 ///
 /// Built with [`FairOptions::default`] and the `with_*` methods; the defaults are in
@@ -113,8 +119,8 @@ pub struct FairOptions {
     ///
     /// Default value: [`EndFix::Free`].
     pub fix_ends: EndFix,
-    /// Upper bound on the method's iterations (its unit: sweeps, moves or passes).
-    /// `None`: the method's own default.
+    /// Upper bound on the method's iterations (its unit: sweeps, moves or passes), from 1 to
+    /// [`MAX_ITERATIONS`]. `None`: the method's own default.
     ///
     /// Default value: `None`.
     pub max_iterations: Option<usize>,
@@ -174,7 +180,8 @@ impl FairOptions {
         self
     }
 
-    /// Check the common options: a tolerance must be finite and positive.
+    /// Check the common options: a tolerance must be finite and positive, an iteration limit
+    /// between 1 and [`MAX_ITERATIONS`].
     ///
     /// # Errors
     /// [`Error::InvalidParameter`].
@@ -185,6 +192,14 @@ impl FairOptions {
             return Err(Error::InvalidParameter {
                 name: "tolerance".into(),
                 reason: format!("must be a positive finite number, got {t}"),
+            });
+        }
+        if let Some(n) = self.max_iterations
+            && !(1..=MAX_ITERATIONS).contains(&n)
+        {
+            return Err(Error::InvalidParameter {
+                name: "max_iterations".into(),
+                reason: format!("{n} is outside [1, {MAX_ITERATIONS}]"),
             });
         }
         Ok(())
@@ -221,7 +236,7 @@ impl FairOptions {
         if !(lo..=hi).contains(&v) {
             return Err(Error::InvalidParameter {
                 name: key.into(),
-                reason: format!("{v} is outside [{lo}, {hi}]"),
+                reason: range_reason(v, lo, hi),
             });
         }
         Ok(v)
@@ -275,6 +290,19 @@ impl FairOptions {
     }
 }
 
+/// Why `v` is not in `[lo, hi]`, in words short enough for one line: the open ends of the
+/// `f64` range (`f64::MIN_POSITIVE`, `f64::MAX`) are said as "positive" and "at least", not
+/// printed as 300-digit numbers; other bounds in their shortest exact form.
+fn range_reason(v: f64, lo: f64, hi: f64) -> String {
+    let num = crate::io::format_f64;
+    match (lo == f64::MIN_POSITIVE, hi == f64::MAX) {
+        (true, true) => format!("must be a positive number, got {}", num(v)),
+        (false, true) => format!("must be at least {}, got {}", num(lo), num(v)),
+        (true, false) => format!("must be positive and at most {}, got {}", num(hi), num(v)),
+        (false, false) => format!("{} is outside [{}, {}]", num(v), num(lo), num(hi)),
+    }
+}
+
 impl Default for FairOptions {
     fn default() -> FairOptions {
         FairOptions::DEFAULT
@@ -290,4 +318,60 @@ pub struct ParamSpec {
     pub default: &'static str,
     /// One line on what it does.
     pub doc: &'static str,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn reason(o: &FairOptions) -> String {
+        match o.validate() {
+            Err(Error::InvalidParameter { reason, .. }) => reason,
+            other => format!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn iteration_limit_is_bounded_both_ways() {
+        let o = FairOptions::default();
+        assert!(o.clone().with_max_iterations(1).validate().is_ok());
+        assert!(
+            o.clone()
+                .with_max_iterations(MAX_ITERATIONS)
+                .validate()
+                .is_ok()
+        );
+        assert_eq!(
+            reason(&o.clone().with_max_iterations(0)),
+            "0 is outside [1, 1000000]"
+        );
+        assert_eq!(
+            reason(&o.with_max_iterations(usize::MAX)),
+            "18446744073709551615 is outside [1, 1000000]"
+        );
+    }
+
+    #[test]
+    fn range_reasons_stay_short() {
+        let o = FairOptions::default().with_param("g", 0);
+        let e = o.param_f64_in("g", 1.0, f64::MIN_POSITIVE, f64::MAX);
+        assert!(
+            matches!(&e, Err(Error::InvalidParameter { reason, .. })
+                if reason == "must be a positive number, got 0"),
+            "{e:?}"
+        );
+        assert_eq!(
+            range_reason(-1.0, 0.5, f64::MAX),
+            "must be at least 0.5, got -1"
+        );
+        assert_eq!(
+            range_reason(3.0, f64::MIN_POSITIVE, 2.0),
+            "must be positive and at most 2, got 3"
+        );
+        assert_eq!(range_reason(2.0, 0.0, 1.0), "2 is outside [0, 1]");
+        assert_eq!(
+            range_reason(1e300, -1e-7, 1.0),
+            "1e300 is outside [-1e-7, 1]"
+        );
+    }
 }

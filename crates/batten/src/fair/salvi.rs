@@ -100,6 +100,13 @@ pub const SAMPLES_PER_SPAN: usize = 8;
 /// Fewest samples accepted.
 pub const MIN_SAMPLES: usize = 4;
 
+/// Most samples accepted when N is given (`--set samples=N`): every iteration re-samples the
+/// curvature, so the time grows with N — about 80 s for the default 1000 iterations at this
+/// bound on a 30-point curve, and minutes beyond. Also the bound of `half_width` and
+/// `target_coefficients`, which are counts of samples. The automatic N is not bounded: it
+/// grows with the curve.
+pub const MAX_SAMPLES: usize = 100_000;
+
 /// The moving-average half-width is `⌊N / HALF_WIDTH_DIVISOR⌋` (spec §3 step 3.2).
 pub const HALF_WIDTH_DIVISOR: usize = 20;
 
@@ -812,7 +819,7 @@ static PARAMS: [ParamSpec; 11] = [
     ParamSpec {
         name: "samples",
         default: "auto",
-        doc: "number of curvature samples N (auto: max(200, 8 per knot span))",
+        doc: "number of curvature samples N (auto: max(200, 8 per knot span); at most 100000)",
     },
     ParamSpec {
         name: "smoother",
@@ -822,7 +829,7 @@ static PARAMS: [ParamSpec; 11] = [
     ParamSpec {
         name: "half_width",
         default: "auto",
-        doc: "moving-average half-width in samples (auto: N/20)",
+        doc: "moving-average half-width in samples (auto: N/20; at most 100000)",
     },
     ParamSpec {
         name: "passes",
@@ -832,7 +839,7 @@ static PARAMS: [ParamSpec; 11] = [
     ParamSpec {
         name: "target_coefficients",
         default: "auto",
-        doc: "coefficients of the bspline target fit (auto: max(4, N/20))",
+        doc: "coefficients of the bspline target fit (auto: max(4, N/20); at most 100000)",
     },
     ParamSpec {
         name: "pin_ends",
@@ -847,7 +854,7 @@ static PARAMS: [ParamSpec; 11] = [
     ParamSpec {
         name: "window",
         default: "50",
-        doc: "stop when the measure improved < 0.1% over this many iterations (0: never)",
+        doc: "stop when the measure improved < 0.1% over this many iterations (0: never; at most 1000000)",
     },
     FIT_PARAMS[0],
     FIT_PARAMS[1],
@@ -961,13 +968,13 @@ fn salvi_params(
     let samples = match options.params.get("samples").map(|s| s.trim()) {
         None | Some("auto") => None,
         Some(_) => {
-            Some(options.param_usize_in("samples", DEFAULT_SAMPLES, MIN_SAMPLES, 10_000_000)?)
+            Some(options.param_usize_in("samples", DEFAULT_SAMPLES, MIN_SAMPLES, MAX_SAMPLES)?)
         }
     };
     let auto_usize = |key: &str, lo: usize| -> Result<Option<usize>> {
         match options.params.get(key).map(|s| s.trim()) {
             None | Some("auto") => Ok(None),
-            Some(_) => options.param_usize_in(key, lo, lo, usize::MAX).map(Some),
+            Some(_) => options.param_usize_in(key, lo, lo, MAX_SAMPLES).map(Some),
         }
     };
     let coefficients = auto_usize("target_coefficients", MIN_TARGET_COEFFICIENTS)?;
@@ -985,7 +992,7 @@ fn salvi_params(
         tolerance,
         tabu_length: options.param_usize_in("tabu", DEFAULT_TABU_LENGTH, 0, 1000)?,
         max_iterations,
-        window: options.param_usize_in("window", DEFAULT_WINDOW, 0, usize::MAX)?,
+        window: options.param_usize_in("window", DEFAULT_WINDOW, 0, super::MAX_ITERATIONS)?,
         min_rel_improvement: WINDOW_MIN_REL_IMPROVEMENT,
         free_ends,
         held_ends: options.fix_ends.held().max(1),
