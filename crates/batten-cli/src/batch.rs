@@ -221,12 +221,7 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
     if let Some(path) = &args.summary {
         check_summary(path, &jobs, &args.out_dir)?;
     }
-    fs::create_dir_all(&args.out_dir).map_err(|e| {
-        Failure::failed(anyhow!(
-            "{}: cannot create directory: {e}",
-            args.out_dir.display()
-        ))
-    })?;
+    create_out_dir(&args.out_dir, args.summary.as_deref())?;
 
     let pool = rayon::ThreadPoolBuilder::new()
         // More threads than files would only idle.
@@ -280,6 +275,50 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
     } else {
         ExitCode::SUCCESS
     })
+}
+
+/// Create the output directory (and its parents) and check that a file can be written in it,
+/// and that the summary can be written once the directory exists. On failure, every
+/// directory this created is removed again: a usage error leaves nothing behind.
+///
+/// # Errors
+/// [`Failure::usage`] (exit 2) naming the directory or the summary.
+fn create_out_dir(out_dir: &Path, summary: Option<&Path>) -> Result<(), Failure> {
+    // The first missing ancestor: what to remove if a check fails.
+    let mut created = None;
+    let mut p = out_dir;
+    while !p.as_os_str().is_empty() && !p.exists() {
+        created = Some(p.to_path_buf());
+        p = p.parent().unwrap_or(Path::new(""));
+    }
+    let checked = fs::create_dir_all(out_dir)
+        .map_err(|e| {
+            Failure::usage(anyhow!(
+                "{}: cannot write: cannot create the directory: {e}",
+                out_dir.display()
+            ))
+        })
+        .and_then(|()| {
+            fair_cmd::check_writable(&out_dir.join("probe.json")).map_err(|_| {
+                Failure::usage(anyhow!(
+                    "{}: cannot write: no file can be created in the directory",
+                    out_dir.display()
+                ))
+            })
+        })
+        .and_then(|()| summary.map_or(Ok(()), fair_cmd::check_writable));
+    if checked.is_err()
+        && let Some(top) = created
+    {
+        // Best effort: only directories this run created, and only when still empty.
+        let mut d = out_dir.to_path_buf();
+        while fs::remove_dir(&d).is_ok() && d != top {
+            if !d.pop() {
+                break;
+            }
+        }
+    }
+    checked
 }
 
 /// A progress bar on stderr, hidden when stderr is not a terminal (tests, CI, logs).
@@ -350,10 +389,16 @@ fn fair_one_inner(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> 
     let report = &faired.report;
     // Tangents: the method's, else the input's carried through (as `batten fair` does).
     let tangents = faired.tangents.as_deref().or(data.tangents.as_deref());
-    let written = io::write_points(&job.output, &faired.points, data.seq.is_closed(), tangents)
+    // The report and the points as one set, the report first (as `batten fair` does).
+    let written = io::encode_points(&job.output, &faired.points, data.seq.is_closed(), tangents)
         .map_err(|e| e.to_string())
-        .and_then(|()| {
-            fair_cmd::write_report(&job.report, report).map_err(|f| f.error.to_string())
+        .and_then(|points| {
+            let report = fair_cmd::report_json(report).map_err(|f| f.error.to_string())?;
+            io::write_atomic_set(&[
+                (&job.report, report.as_bytes()),
+                (&job.output, points.as_bytes()),
+            ])
+            .map_err(|e| e.to_string())
         });
     let (status, error) = match written {
         Err(message) => (Status::Failed, Some(message)),
@@ -413,8 +458,16 @@ fn expand(args: &[PathBuf]) -> Result<Vec<PathBuf>, Failure> {
                 )));
             }
             inputs.extend(found);
+        } else if !arg.exists() && Format::from_path(arg).is_err() {
+            // Not a point file by name, and nothing there: most likely a folder that is not
+            // there (`scans/`). Say so, rather than "unknown file format" for each.
+            return Err(Failure::usage(anyhow!(
+                "{}: no such file or directory",
+                arg.display()
+            )));
         } else {
-            // A file, or a path that does not exist: reading it reports what is wrong.
+            // A file, or a point file that does not exist: reading it reports what is wrong,
+            // as a row of the summary.
             inputs.push(arg.clone());
         }
     }
@@ -594,14 +647,8 @@ fn check_summary(path: &Path, jobs: &[Job], out_dir: &Path) -> Result<(), Failur
             (fs::canonicalize(dir), fs::canonicalize(out_dir)),
             (Ok(a), Ok(b)) if a == b
         );
-    if path.is_dir() {
-        return Err(Failure::usage(anyhow!(
-            "--summary {}: is a directory",
-            path.display()
-        )));
-    }
-    if !in_out_dir {
-        fair_cmd::check_directory(path)?;
+    if path.is_dir() || !in_out_dir {
+        fair_cmd::check_writable(path)?;
     }
     if let Ok(real) = fs::canonicalize(path) {
         for job in jobs {

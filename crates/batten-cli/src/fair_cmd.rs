@@ -37,9 +37,9 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
     );
     input::check(method, args.closed, &options)?;
     Format::from_path(&args.output).map_err(Failure::usage)?;
-    check_directory(&args.output)?;
+    check_writable(&args.output)?;
     if let Some(report) = &args.report {
-        check_directory(report)?;
+        check_writable(report)?;
     }
 
     if let Some(curve_out) = &args.curve_out {
@@ -49,7 +49,7 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
                 curve_out.display()
             )));
         }
-        check_directory(curve_out)?;
+        check_writable(curve_out)?;
         io::ensure_distinct(&args.input, curve_out).map_err(Failure::usage)?;
         let clash = same_path(curve_out, &args.output)
             || args
@@ -125,13 +125,23 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         .tangents
         .as_deref()
         .or(data.and_then(|d| d.tangents.as_deref()));
-    io::write_points(&args.output, &faired.points, closed, tangents).map_err(Failure::failed)?;
-    if let Some(path) = &args.report {
-        write_report(path, &faired.report)?;
-    }
-    if let Some(path) = &args.curve_out {
-        write_curve(path, &faired, closed)?;
-    }
+    // One set, all or none: the report and the curve first, the points last, so that a
+    // faired file beside an older report cannot happen (see `io::write_atomic_set`).
+    let points = io::encode_points(&args.output, &faired.points, closed, tangents)
+        .map_err(Failure::failed)?;
+    let report = match &args.report {
+        Some(path) => Some((path, report_json(&faired.report)?)),
+        None => None,
+    };
+    let curve = match &args.curve_out {
+        Some(path) => Some((path, curve_json(path, &faired, closed)?)),
+        None => None,
+    };
+    let mut set: Vec<(&Path, &[u8])> = Vec::with_capacity(3);
+    set.extend(report.iter().map(|(p, t)| (p.as_path(), t.as_bytes())));
+    set.extend(curve.iter().map(|(p, t)| (p.as_path(), t.as_bytes())));
+    set.push((&args.output, points.as_bytes()));
+    io::write_atomic_set(&set).map_err(Failure::failed)?;
 
     output::note(&summary(&faired.report, data));
     if faired.report.tolerance_met {
@@ -151,21 +161,14 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
     }
 }
 
-/// A file can only be written into a directory that exists: say so before fairing.
-pub fn check_directory(path: &Path) -> Result<(), Failure> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    if dir.is_dir() {
-        Ok(())
-    } else {
-        Err(Failure::usage(anyhow!(
-            "{}: cannot write: directory {} does not exist",
-            path.display(),
-            dir.display()
-        )))
-    }
+/// Whether an output can be written (not a directory, in a directory that exists and takes
+/// new files), checked before any work so that "cannot write" is a usage error (exit 2)
+/// that leaves nothing behind.
+///
+/// # Errors
+/// [`Failure::usage`] naming the path and what stands in the way.
+pub fn check_writable(path: &Path) -> Result<(), Failure> {
+    io::check_writable(path).map_err(Failure::usage)
 }
 
 /// Whether two paths name the same file, as far as can be told before either exists.
@@ -180,9 +183,9 @@ enum Source {
     Curve(BSplineCurve),
 }
 
-/// Write the faired curve as B-spline JSON, atomically: the method's own B-spline, or the
-/// analysis curve (the C² cubic through the faired points) converted exactly to B-spline form.
-fn write_curve(path: &Path, faired: &Faired, closed: bool) -> Result<(), Failure> {
+/// The faired curve as B-spline JSON: the method's own B-spline, or the analysis curve (the
+/// C² cubic through the faired points) converted exactly to B-spline form.
+fn curve_json(path: &Path, faired: &Faired, closed: bool) -> Result<String, Failure> {
     let converted;
     let curve = match &faired.curve {
         Some(c) => c,
@@ -200,15 +203,15 @@ fn write_curve(path: &Path, faired: &Faired, closed: bool) -> Result<(), Failure
     let mut json = serde_json::to_string_pretty(curve)
         .map_err(|e| Failure::failed(anyhow!("cannot encode the curve: {e}")))?;
     json.push('\n');
-    io::write_atomic(path, json.as_bytes()).map_err(Failure::failed)
+    Ok(json)
 }
 
-/// Write the report as pretty JSON, atomically.
-pub fn write_report(path: &Path, report: &FairReport) -> Result<(), Failure> {
+/// The report as pretty JSON.
+pub fn report_json(report: &FairReport) -> Result<String, Failure> {
     let mut json = serde_json::to_string_pretty(report)
         .map_err(|e| Failure::failed(anyhow!("cannot encode the report: {e}")))?;
     json.push('\n');
-    io::write_atomic(path, json.as_bytes()).map_err(Failure::failed)
+    Ok(json)
 }
 
 /// The one-line summary: method, status, iterations, largest displacement (and where),

@@ -9,6 +9,8 @@
 //! - [`read_curve_json`] reads a B-spline curve; [`read_points`] refuses one.
 //! - [`write_points`] writes atomically (a temporary file beside the target, renamed over it)
 //!   and numbers in their shortest exact form: what is written reads back bit for bit.
+//!   [`write_atomic_set`] writes several files all or none; [`check_writable`] tells before
+//!   any work whether an output can be created; [`remove_temporaries`] cleans up on a signal.
 //! - [`ensure_distinct`] refuses an output path that is the input file.
 //!
 //! Nothing here prints; every failure is an [`IoError`].
@@ -45,15 +47,15 @@
 //! # }
 //! ```
 
+mod atomic;
 mod error;
 mod json;
 mod text;
 
 use std::fs;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
+pub use atomic::{check_writable, remove_temporaries, write_atomic, write_atomic_set};
 pub use error::IoError;
 pub use text::format_f64;
 
@@ -272,6 +274,21 @@ pub fn write_points(
     closed: bool,
     tangents: Option<&[Vec2]>,
 ) -> Result<(), IoError> {
+    let contents = encode_points(path, points, closed, tangents)?;
+    write_atomic(path, contents.as_bytes())
+}
+
+/// The text [`write_points`] would write to `path` (format by extension), to write it later
+/// with other files as one set ([`write_atomic_set`]).
+///
+/// # Errors
+/// [`IoError::UnknownFormat`], [`IoError::NonFiniteOutput`].
+pub fn encode_points(
+    path: &Path,
+    points: &[Point],
+    closed: bool,
+    tangents: Option<&[Vec2]>,
+) -> Result<String, IoError> {
     let format = Format::from_path(path)?;
     let bad_point = points.iter().position(|p| !p.is_finite());
     let bad_tangent = tangents.and_then(|t| t.iter().position(|v| !v.is_finite()));
@@ -281,72 +298,9 @@ pub fn write_points(
             index,
         });
     }
-    let contents = match format {
+    Ok(match format {
         Format::Text => text::format(points),
         Format::Json => json::format(points, closed, tangents),
-    };
-    write_atomic(path, contents.as_bytes())
-}
-
-/// Distinguishes temporary files of concurrent writes from one process.
-static TEMP_COUNTER: AtomicUsize = AtomicUsize::new(0);
-
-/// How many temporary names to try before giving up.
-const TEMP_ATTEMPTS: usize = 64;
-
-/// Write `contents` to `path` atomically: into a new temporary file in the same directory
-/// (`.NAME.PID.N.tmp`), flushed to disk, then renamed over `path`. Readers see the old file
-/// or the new one, never a partial one; on failure the temporary file is removed and `path`
-/// is untouched. The new file has default permissions; a symbolic link at `path` is
-/// replaced by the file, not followed.
-///
-/// # Errors
-/// [`IoError::Write`].
-pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), IoError> {
-    let write_err = |source| IoError::Write {
-        path: path.to_path_buf(),
-        source,
-    };
-    let name = path.file_name().ok_or_else(|| {
-        write_err(std::io::Error::new(
-            std::io::ErrorKind::InvalidInput,
-            "not a file name",
-        ))
-    })?;
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut attempt = 0;
-    let (tmp, mut file) = loop {
-        let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
-        let mut tmp_name = std::ffi::OsString::from(".");
-        tmp_name.push(name);
-        tmp_name.push(format!(".{}.{n}.tmp", std::process::id()));
-        let tmp = dir.join(tmp_name);
-        match fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&tmp)
-        {
-            Ok(f) => break (tmp, f),
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && attempt < TEMP_ATTEMPTS => {
-                attempt += 1;
-            }
-            Err(e) => return Err(write_err(e)),
-        }
-    };
-    let result = file
-        .write_all(contents)
-        .and_then(|()| file.sync_all())
-        .and_then(|()| {
-            drop(file);
-            fs::rename(&tmp, path)
-        });
-    result.map_err(|e| {
-        // Best effort: the temporary file may already be gone.
-        let _ = fs::remove_file(&tmp);
-        write_err(e)
     })
 }
 
@@ -418,7 +372,9 @@ mod tests {
     }
 
     fn tempdir() -> PathBuf {
-        let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        static DIRS: AtomicUsize = AtomicUsize::new(0);
+        let n = DIRS.fetch_add(1, Ordering::Relaxed);
         let d = std::env::temp_dir().join(format!("batten-io-test-{}-{n}", std::process::id()));
         fs::create_dir_all(&d).unwrap();
         d
