@@ -263,9 +263,9 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
     let (ok, exceeded) = (count(Status::Ok), count(Status::ToleranceExceeded));
     let (failed, invalid) = (count(Status::Failed), count(Status::InvalidInput));
     output::note(&format!(
-        "batch: {} files: {ok} ok, {exceeded} tolerance exceeded, {failed} failed, \
+        "batch: {}: {ok} ok, {exceeded} tolerance exceeded, {failed} failed, \
          {invalid} invalid input; results in {}",
-        rows.len(),
+        output::count(rows.len(), "file"),
         args.out_dir.display()
     ));
     Ok(if invalid > 0 {

@@ -93,7 +93,11 @@ pub fn run(args: &EvaluateArgs) -> Result<ExitCode, Failure> {
     let what = format!("{name}: cannot evaluate");
     // A JSON file may hold a B-spline curve; anything else is a point list.
     let curve = match io::Format::from_path(&args.input) {
-        Ok(io::Format::Json) => io::read_curve_json(&args.input).ok(),
+        Ok(io::Format::Json) => match io::read_curve_json(&args.input) {
+            Ok(c) => Some(c),
+            Err(io::IoError::PointsNotCurve { .. }) => None,
+            Err(e) => return Err(Failure::usage(e)),
+        },
         _ => None,
     };
     let evaluation = match &curve {

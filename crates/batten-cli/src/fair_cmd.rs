@@ -233,9 +233,9 @@ fn summary(r: &FairReport, data: Option<&PointData>) -> String {
         Some(t) => format!("tolerance {} NOT met", format_f64(t)),
     };
     format!(
-        "{}: {status}, {} iterations, max displacement {}{at}, {tolerance}",
+        "{}: {status}, {}, max displacement {}{at}, {tolerance}",
         r.method,
-        r.iterations,
+        output::count(r.iterations, "iteration"),
         sig(r.max_displacement, DIGITS),
     )
 }

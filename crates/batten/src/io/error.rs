@@ -83,8 +83,44 @@ pub enum IoError {
         /// The 1-based line of the point.
         line: usize,
     },
+    /// A coordinate beyond [`super::MAX_COORDINATE`] in magnitude.
+    #[error(
+        "{}:{line}: coordinate {} is beyond ±1e300, the largest magnitude batten takes \
+         (rescale the data)",
+        path.display(),
+        super::format_f64(*value)
+    )]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// The 1-based line of the point.
+        line: usize,
+        /// The coordinate.
+        value: f64,
+    },
+    /// A point nearly duplicates its neighbour: closer than
+    /// [`super::NEAR_DUPLICATE_RELATIVE`] times the bounding-box diagonal.
+    #[error(
+        "{}:{line}: point nearly duplicates the one on line {other} ({} apart, under {} = \
+         1e-10 of the bounding-box diagonal); remove one of them",
+        path.display(),
+        super::format_f64(*distance),
+        super::format_f64(*threshold)
+    )]
+    NearDuplicate {
+        /// The file.
+        path: PathBuf,
+        /// The 1-based line of the later point.
+        line: usize,
+        /// The 1-based line of the point it nearly repeats.
+        other: usize,
+        /// Their distance.
+        distance: f64,
+        /// The distance below which points are refused.
+        threshold: f64,
+    },
     /// Fewer points than batten needs ([`crate::PointSeq::MIN_POINTS`]).
-    #[error("{}: {got} points, at least {needed} needed", path.display())]
+    #[error("{}: {got} point{}, at least {needed} needed", path.display(), plural(*got))]
     TooFewPoints {
         /// The file.
         path: PathBuf,
@@ -144,7 +180,12 @@ pub enum IoError {
         message: String,
     },
     /// A JSON point list whose `tangents` array has a different length than `points`.
-    #[error("{}: {got} tangents for {expected} points", path.display())]
+    #[error(
+        "{}: {got} tangent{} for {expected} point{}",
+        path.display(),
+        plural(*got),
+        plural(*expected)
+    )]
     TangentCount {
         /// The file.
         path: PathBuf,
@@ -197,4 +238,9 @@ pub enum IoError {
         /// The output path as given.
         output: PathBuf,
     },
+}
+
+/// The plural ending of a count: "1 point", "2 points".
+fn plural(n: usize) -> &'static str {
+    if n == 1 { "" } else { "s" }
 }

@@ -50,6 +50,7 @@
 mod atomic;
 mod error;
 mod json;
+mod limits;
 mod text;
 
 use std::fs;
@@ -57,6 +58,7 @@ use std::path::{Path, PathBuf};
 
 pub use atomic::{check_writable, remove_temporaries, write_atomic, write_atomic_set};
 pub use error::IoError;
+pub use limits::{MAX_COORDINATE, NEAR_DUPLICATE_RELATIVE};
 pub use text::format_f64;
 
 use crate::error::Error;
@@ -149,7 +151,9 @@ pub fn read_points(path: &Path, options: &ReadOptions) -> Result<PointData, IoEr
 /// One error naming the line, for the first problem met: [`IoError::NotUtf8`],
 /// [`IoError::FieldCount`], [`IoError::NotANumber`], [`IoError::NonFinite`], [`IoError::Json`],
 /// [`IoError::CurveNotPoints`]; then, for the whole list, [`IoError::Empty`],
-/// [`IoError::TooFewPoints`], [`IoError::DuplicatePoint`], [`IoError::RepeatsFirst`],
+/// [`IoError::TooLarge`] (beyond [`MAX_COORDINATE`]), [`IoError::TooFewPoints`],
+/// [`IoError::DuplicatePoint`], [`IoError::RepeatsFirst`], [`IoError::NearDuplicate`]
+/// (closer than [`NEAR_DUPLICATE_RELATIVE`] of the bounding-box diagonal),
 /// [`IoError::TangentCount`].
 pub fn parse_points(
     bytes: &[u8],
@@ -204,8 +208,12 @@ fn validate(
         });
     }
     let line = |i: usize| lines.get(i).copied().unwrap_or(1);
+    limits::check_magnitudes(path, &points, lines)?;
     match PointSeq::new(points.clone(), closed) {
-        Ok(seq) => Ok(seq),
+        Ok(seq) => {
+            limits::check_near_duplicates(path, seq.points(), lines, closed)?;
+            Ok(seq)
+        }
         Err(Error::TooFewPoints { needed, got }) => Err(IoError::TooFewPoints {
             path: path.to_path_buf(),
             got,
@@ -250,6 +258,14 @@ pub fn read_curve_json(path: &Path) -> Result<BSplineCurve, IoError> {
     }
     let bytes = read_bytes(path)?;
     json::parse_curve(&bytes, path)
+}
+
+/// Parse a B-spline curve held in memory as JSON; `path` names it in messages.
+///
+/// # Errors
+/// As [`read_curve_json`], less the reading.
+pub fn parse_curve_json(bytes: &[u8], path: &Path) -> Result<BSplineCurve, IoError> {
+    json::parse_curve(bytes, path)
 }
 
 fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
@@ -473,7 +489,7 @@ mod tests {
         )
         .unwrap_err()
         .to_string();
-        assert_eq!(e, "d.json: 1 tangents for 4 points");
+        assert_eq!(e, "d.json: 1 tangent for 4 points");
         let e = parse_points(
             b"{\"points\": []}",
             Format::Json,
@@ -492,7 +508,7 @@ mod tests {
             Point::new(-0.0, 1e-300),
             Point::new(1e300, 5e-324),
             Point::new(0.1, -1.0 / 3.0),
-            Point::new(f64::MIN_POSITIVE / 3.0, f64::MAX),
+            Point::new(f64::MIN_POSITIVE / 3.0, -MAX_COORDINATE),
             Point::new(std::f64::consts::PI, -1e-7),
         ];
         let tangents = vec![Vec2::new(0.6, 0.8); 5];
@@ -510,8 +526,11 @@ mod tests {
         }
         let text = fs::read_to_string(dir.join("p.csv")).unwrap();
         assert!(text.starts_with("x,y\n-0,1e-300\n1e300,5e-324\n"), "{text}");
+        // Closed, the last point must not nearly repeat the first (relative to the extent).
         let path = dir.join("closed.json");
-        write_points(&path, &pts, true, None).unwrap();
+        let square =
+            [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)].map(|(x, y)| Point::new(x, y));
+        write_points(&path, &square, true, None).unwrap();
         assert!(
             read_points(&path, &ReadOptions::DEFAULT)
                 .unwrap()

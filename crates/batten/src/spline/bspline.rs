@@ -23,6 +23,7 @@ pub struct BSplineCurve {
 }
 
 #[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 struct BSplineJson {
     degree: usize,
     knots: Vec<f64>,
