@@ -24,6 +24,7 @@ use std::io::IsTerminal as _;
 use std::panic::{self, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::{Arc, Mutex};
 
 use anyhow::anyhow;
 use batten::FairOptions;
@@ -37,7 +38,7 @@ use serde::Serialize;
 use crate::compare::{csv_field, csv_num};
 use crate::failure::{EXIT_FAILED, EXIT_USAGE, Failure};
 use crate::output::{self, sig};
-use crate::{fair_cmd, input};
+use crate::{fair_cmd, input, signals};
 
 /// Significant digits of displacements in messages.
 const DIGITS: usize = 4;
@@ -106,6 +107,9 @@ enum Status {
     Failed,
     /// The file could not be read, or its data or its closedness was rejected.
     InvalidInput,
+    /// The batch was interrupted (SIGINT, SIGTERM) before this file finished; nothing of it
+    /// was written. Only in the summary an interrupted batch leaves.
+    Interrupted,
 }
 
 impl Status {
@@ -116,12 +120,13 @@ impl Status {
             Status::ToleranceExceeded => "tolerance_exceeded",
             Status::Failed => "failed",
             Status::InvalidInput => "invalid_input",
+            Status::Interrupted => "interrupted",
         }
     }
 }
 
 /// One input: where it is read from and where its results go.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 struct Job {
     input: PathBuf,
     output: PathBuf,
@@ -130,7 +135,7 @@ struct Job {
 
 /// One row of the summary. Fields that are not known for a row (the metrics of a file that
 /// could not be read) are `null` in JSON and empty in CSV.
-#[derive(Debug, Serialize)]
+#[derive(Clone, Debug, Serialize)]
 struct Row {
     file: String,
     status: Status,
@@ -229,10 +234,54 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
         .build()
         .map_err(|e| Failure::failed(anyhow!("cannot start worker threads: {e}")))?;
     let bar = progress_bar(jobs.len());
+    // The rows of the files that have finished, for the summary an interrupt leaves.
+    let finished: Arc<Mutex<Vec<Option<Row>>>> = Arc::new(Mutex::new(vec![None; jobs.len()]));
+    if let (Some(path), Some(format)) = (&args.summary, summary_format) {
+        let (finished, jobs, path) = (Arc::clone(&finished), jobs.clone(), path.clone());
+        signals::set_last_word(move || {
+            let slots = std::mem::take(&mut *finished.lock().unwrap_or_else(|e| e.into_inner()));
+            let done = slots.iter().filter(|r| r.is_some()).count();
+            let rows: Vec<Row> = slots
+                .into_iter()
+                .zip(&jobs)
+                .map(|(row, job)| {
+                    row.unwrap_or_else(|| {
+                        let why = "batch interrupted before this file finished".to_string();
+                        Row::new(job, Status::Interrupted, Some(why), None, None)
+                    })
+                })
+                .collect();
+            let text = match format {
+                SummaryFormat::Json => summary_json(&rows),
+                SummaryFormat::Csv => Ok(summary_csv(&rows)),
+            };
+            Some(
+                match text
+                    .and_then(|t| io::write_atomic(&path, t.as_bytes()).map_err(|e| e.to_string()))
+                {
+                    Ok(()) => format!(
+                        "summary of the {done} of {} that finished written to {}, the others \
+                         marked interrupted",
+                        output::count(rows.len(), "file"),
+                        path.display()
+                    ),
+                    Err(e) => format!("summary not written: {e}"),
+                },
+            )
+        });
+    }
     let rows: Vec<Row> = pool.install(|| {
         jobs.par_iter()
-            .map(|job| {
+            .enumerate()
+            .map(|(i, job)| {
                 let row = fair_one(job, method, &options);
+                if let Some(slot) = finished
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .get_mut(i)
+                {
+                    *slot = Some(row.clone());
+                }
                 bar.inc(1);
                 row
             })
@@ -255,6 +304,7 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
             output::error_line(message);
         }
     }
+    signals::clear_last_word();
     let summary_failed = summary_written.is_err();
     if let Err(message) = summary_written {
         output::error_line(&message);

@@ -21,6 +21,7 @@ mod methods;
 mod output;
 mod plot;
 mod report;
+mod signals;
 mod usage;
 
 use std::path::PathBuf;
@@ -170,6 +171,7 @@ fn main() -> ExitCode {
             }
         },
     };
+    signals::install();
     let result = match cli.command {
         Command::Analyze(a) => analyze::run(&a),
         Command::Fair(a) => fair_cmd::run(&a),

@@ -59,6 +59,17 @@ pub(crate) fn arc_lengths_at_sorted(curve: &BSplineCurve, ts: &[f64]) -> Vec<f64
     let piece = |(a, b): (f64, f64)| {
         if curve.weights().is_some() {
             gl.integrate(a, b, |x| curve.first_derivative(x).length_squared().sqrt())
+        } else if curve.degree() <= 3 {
+            // x' of a polynomial piece of degree ≤ 3 is its Taylor expansion about the
+            // piece's midpoint, exactly: one basis evaluation per piece instead of one per
+            // node (the speed of 10⁶-point GFIs, issue #14).
+            let half = 0.5 * (b - a);
+            let mid = a + half;
+            let d = curve.derivs_in_span(curve.find_span(mid), mid);
+            let d3_half = d.d3 * 0.5;
+            gl.integrate(-half, half, |s| {
+                (d.d1 + (d.d2 + d3_half * s) * s).length_squared().sqrt()
+            })
         } else {
             // One span search per piece; the nodes are inside it.
             let span = curve.find_span(0.5 * (a + b));

@@ -99,10 +99,10 @@ pub enum IoError {
         value: f64,
     },
     /// A point nearly duplicates its neighbour: closer than
-    /// [`super::NEAR_DUPLICATE_RELATIVE`] times the bounding-box diagonal.
+    /// [`super::NEAR_DUPLICATE_RELATIVE`] times the larger side of the bounding box.
     #[error(
-        "{}:{line}: point nearly duplicates the one on line {other} ({} apart, under {} = \
-         1e-10 of the bounding-box diagonal); remove one of them",
+        "{}:{line}: point nearly duplicates the one on line {other} ({} apart, under {}, \
+         1e-12 of the curve's size); remove one of them",
         path.display(),
         super::format_f64(*distance),
         super::format_f64(*threshold)

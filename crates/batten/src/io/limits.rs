@@ -18,15 +18,16 @@ use crate::geom::{BBox, Point};
 /// are a matter of scale.
 pub const MAX_COORDINATE: f64 = 1e300;
 
-/// Two consecutive points closer than this fraction of the bounding-box diagonal are refused
-/// as near-duplicates.
+/// Two consecutive points closer than this fraction of the larger side of the bounding box
+/// are refused as near-duplicates.
 ///
-/// The curves batten fits are parametrised by chord length; a chord `1e-15` long next to
-/// chords of `0.1` makes the spline's linear system singular in floating point (issue #14:
-/// "zero pivot in band LU"). At `1e-10` of the diagonal the system is still well within
-/// `f64` precision, and a file would need ten billion evenly spaced points before honest
-/// sampling came near the bound.
-pub const NEAR_DUPLICATE_RELATIVE: f64 = 1e-10;
+/// Coordinates of magnitude `R` carry a rounding of about `1e-16 R`, so a chord of `1e-12` of
+/// the curve's size has its length and direction known to no better than `1e-4`: every
+/// chord-length spline through it (the analysis curve, most methods) is then shaped by
+/// rounding, and near `1e-15` its linear system is singular (issue #14: two points `1e-15`
+/// apart gave "zero pivot in band LU"). The densest scans batten is meant for (10⁷ points)
+/// have chords near `1e-7` of the size.
+pub const NEAR_DUPLICATE_RELATIVE: f64 = 1e-12;
 
 /// Refuse a coordinate beyond [`MAX_COORDINATE`], naming its line.
 pub(crate) fn check_magnitudes(
@@ -49,8 +50,8 @@ pub(crate) fn check_magnitudes(
 }
 
 /// Refuse two consecutive points (and, on a closed curve, the last and the first) closer
-/// than [`NEAR_DUPLICATE_RELATIVE`] times the bounding-box diagonal. Exact duplicates are
-/// the caller's to report first.
+/// than [`NEAR_DUPLICATE_RELATIVE`] times the larger side of the bounding box. Exact
+/// duplicates are left to [`crate::PointSeq::new`], which names them as such.
 pub(crate) fn check_near_duplicates(
     path: &Path,
     points: &[Point],
@@ -60,14 +61,15 @@ pub(crate) fn check_near_duplicates(
     let Some(bbox) = BBox::from_points(points) else {
         return Ok(());
     };
-    let threshold = NEAR_DUPLICATE_RELATIVE * bbox.diagonal();
+    let size = (bbox.max.x - bbox.min.x).max(bbox.max.y - bbox.min.y);
+    let threshold = NEAR_DUPLICATE_RELATIVE * size;
     let n = points.len();
     let pairs = (1..n)
         .map(|i| (i - 1, i))
         .chain((closed && n > 2).then_some((0, n - 1)));
     for (a, b) in pairs {
         let d = points[a].distance(points[b]);
-        if d < threshold {
+        if d > 0.0 && d < threshold {
             let line = |i: usize| lines.get(i).copied().unwrap_or(1);
             return Err(IoError::NearDuplicate {
                 path: path.to_path_buf(),
@@ -119,8 +121,7 @@ mod tests {
         assert_eq!(
             msg("0,0\n1,1\n1.000000000000001,1\n2,0\n3,1\n", false),
             "d.csv:3: point nearly duplicates the one on line 2 (1.1102230246251565e-15 apart, \
-             under 3.1622776601683795e-10 = 1e-10 of the bounding-box diagonal); remove one of \
-             them"
+             under 3e-12, 1e-12 of the curve's size); remove one of them"
         );
         // The same spacing is fine at a scale where it is not small: the test is relative.
         let s = |v: f64| format!("{v}");
@@ -135,11 +136,16 @@ mod tests {
         assert_eq!(msg(&tiny, false), "");
         // On a closed curve, the last point against the first.
         assert_eq!(
-            msg("0,0\n1,0\n1,1\n0,1\n0,1e-12\n", true),
-            "d.csv:5: point nearly duplicates the one on line 1 (1e-12 apart, under \
-             1.4142135623730953e-10 = 1e-10 of the bounding-box diagonal); remove one of them"
+            msg("0,0\n1,0\n1,1\n0,1\n0,1e-13\n", true),
+            "d.csv:5: point nearly duplicates the one on line 1 (1e-13 apart, under 1e-12, \
+             1e-12 of the curve's size); remove one of them"
         );
-        assert_eq!(msg("0,0\n1,0\n1,1\n0,1\n0,1e-12\n", false), "");
+        assert_eq!(msg("0,0\n1,0\n1,1\n0,1\n0,1e-13\n", false), "");
+        // Exact duplicates keep their own message.
+        assert_eq!(
+            msg("0,0\n1,0\n1,0\n0,1\n", false),
+            "d.csv:3: point duplicates the previous one (line 2)"
+        );
     }
 
     #[test]

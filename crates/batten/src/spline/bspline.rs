@@ -260,7 +260,7 @@ impl BSplineCurve {
     }
 
     /// Position and up to three derivatives, evaluated on span `k`.
-    fn derivs_in_span(&self, k: usize, t: f64) -> Derivatives {
+    pub(crate) fn derivs_in_span(&self, k: usize, t: f64) -> Derivatives {
         let p = self.degree;
         let mut b = [[0.0; MAX_ORDER]; 4];
         basis_derivs(self.knots.as_slice(), p, k, t, 3, &mut b);
