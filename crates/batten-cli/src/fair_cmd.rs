@@ -13,6 +13,7 @@ use crate::FairArgs;
 use crate::failure::{EXIT_FAILED, Failure};
 use crate::input;
 use crate::output::{self, sig};
+use crate::spinner::Spinner;
 
 /// Significant digits in the summary line.
 const DIGITS: usize = 4;
@@ -110,6 +111,7 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
     let input_name = args.input.display();
     let failed =
         |e| Failure::from_batten(&format!("{input_name}: method {} failed", method.name()), e);
+    let spinner = Spinner::start(format!("fairing with {}", method.name()));
     let faired = match &source {
         Source::Curve(curve) => fair::fair_curve(method.name(), curve, &options).map_err(failed)?,
         Source::Points(d) => fair::fair_with(method, &d.seq, &options).map_err(failed)?,
@@ -142,6 +144,7 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
     set.extend(curve.iter().map(|(p, t)| (p.as_path(), t.as_bytes())));
     set.push((&args.output, points.as_bytes()));
     io::write_atomic_set(&set).map_err(Failure::failed)?;
+    spinner.finish();
 
     output::note(&summary(&faired.report, data));
     if faired.report.tolerance_met {

@@ -22,6 +22,7 @@ mod output;
 mod plot;
 mod report;
 mod signals;
+mod spinner;
 mod usage;
 
 use std::path::PathBuf;

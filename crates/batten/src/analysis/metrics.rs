@@ -344,6 +344,10 @@ impl FairnessMetrics {
                 .iter()
                 .sum()
         } else {
+            // The open GFI is measured on another spline: free this one first (72 bytes a
+            // point), so that the two are never held at once.
+            drop(curve);
+            drop(s_knots);
             let (bs, _) = BSplineCurve::interpolate(seq.points(), 3, Parametrization::ChordLength)?;
             fairness_indicators(&bs).gfi
         };
