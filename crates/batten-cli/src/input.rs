@@ -93,7 +93,7 @@ pub fn parse_tolerance(s: &str) -> Result<Tolerance, String> {
     let what = match s.trim().parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 => return Ok(Tolerance::Given(v)),
         Ok(v) if v < 0.0 => "is negative",
-        Ok(v) if v == 0.0 => "is zero",
+        Ok(0.0) => "is zero",
         Ok(_) => "is not finite",
         Err(_) => "is not a number",
     };

@@ -74,7 +74,7 @@ fn one_line(e: &clap::Error, argv: &[String]) -> String {
             format!("invalid value '{value}' for {}: {why}", flag(&arg))
         }
         ErrorKind::UnknownArgument => match flag_before(&arg, argv) {
-            Some(f) if f == "--fix-ends" => format!(
+            Some("--fix-ends") => format!(
                 "unexpected argument '{arg}': --fix-ends takes its value after '=', as in \
                  --fix-ends={arg}"
             ),
