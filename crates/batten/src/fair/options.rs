@@ -119,8 +119,9 @@ pub struct FairOptions {
     ///
     /// Default value: [`EndFix::Free`].
     pub fix_ends: EndFix,
-    /// Upper bound on the method's iterations (its unit: sweeps, moves or passes), from 1 to
-    /// [`MAX_ITERATIONS`]. `None`: the method's own default.
+    /// Upper bound on the method's iterations (its unit: sweeps, moves or passes), from 0 (the
+    /// method's starting state, e.g. `kuragano`'s design curve) to [`MAX_ITERATIONS`]. `None`:
+    /// the method's own default. The CLI takes 1 and up.
     ///
     /// Default value: `None`.
     pub max_iterations: Option<usize>,
@@ -181,7 +182,7 @@ impl FairOptions {
     }
 
     /// Check the common options: a tolerance must be finite and positive, an iteration limit
-    /// between 1 and [`MAX_ITERATIONS`].
+    /// at most [`MAX_ITERATIONS`].
     ///
     /// # Errors
     /// [`Error::InvalidParameter`].
@@ -195,11 +196,11 @@ impl FairOptions {
             });
         }
         if let Some(n) = self.max_iterations
-            && !(1..=MAX_ITERATIONS).contains(&n)
+            && n > MAX_ITERATIONS
         {
             return Err(Error::InvalidParameter {
                 name: "max_iterations".into(),
-                reason: format!("{n} is outside [1, {MAX_ITERATIONS}]"),
+                reason: format!("{n} is outside [0, {MAX_ITERATIONS}]"),
             });
         }
         Ok(())
@@ -334,6 +335,7 @@ mod tests {
     #[test]
     fn iteration_limit_is_bounded_both_ways() {
         let o = FairOptions::default();
+        assert!(o.clone().with_max_iterations(0).validate().is_ok());
         assert!(o.clone().with_max_iterations(1).validate().is_ok());
         assert!(
             o.clone()
@@ -342,12 +344,12 @@ mod tests {
                 .is_ok()
         );
         assert_eq!(
-            reason(&o.clone().with_max_iterations(0)),
-            "0 is outside [1, 1000000]"
+            reason(&o.clone().with_max_iterations(MAX_ITERATIONS + 1)),
+            "1000001 is outside [0, 1000000]"
         );
         assert_eq!(
             reason(&o.with_max_iterations(usize::MAX)),
-            "18446744073709551615 is outside [1, 1000000]"
+            "18446744073709551615 is outside [0, 1000000]"
         );
     }
 
