@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# Browser check of `batten report`: build the report of a bundled example, load it in
-# headless Chromium, check that the page loaded (the DOM has the comparison table and the
-# inline SVG plots) and that its screenshot is not blank.
+# Browser check of `batten report`: build the reports of a bundled curve and of the bundled
+# dented hood surface, load each in headless Chromium, check that the page loaded (the DOM
+# has the comparison table and the inline SVG plots or PNG pictures) and that its
+# screenshot is not blank.
 #
 # Usage: scripts/check_report_browser.sh [OUT_DIR]
-#   OUT_DIR keeps report.html, dom.html and screenshot.png (default: a temporary directory,
+#   OUT_DIR keeps report.html, surface-report.html, and for each page (curve, surface)
+#   PAGE-dom.html and PAGE-screenshot.png (default: a temporary directory,
 #   removed at the end). Needs chromium (Debian: apt-get install chromium) and python3.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -29,6 +31,9 @@ cargo build --release -q -p batten-cli
 target/release/batten report "$example" --methods han,mst,kjellander --tolerance 0.1 \
   -o "$out/report.html"
 test -s "$out/report.html"
+# The surface page: curvature maps, isophotes and zebra as inline PNG images.
+target/release/batten report examples/data/hood-dented.json -o "$out/surface-report.html"
+test -s "$out/surface-report.html"
 
 chrome() {
   timeout 120 chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run \
@@ -36,25 +41,26 @@ chrome() {
     --user-data-dir="$profile" "$@"
 }
 
-url="file://$(realpath "$out/report.html")"
-chrome --dump-dom "$url" >"$out/dom.html" 2>/dev/null
-chrome --screenshot="$out/screenshot.png" --window-size=1200,2000 "$url" >/dev/null 2>&1
-test -s "$out/screenshot.png"
-
-python3 - "$out/dom.html" "$out/screenshot.png" <<'EOF'
+cat >"$profile/check.py" <<'EOF'
 import re, struct, sys, zlib
 
 dom = open(sys.argv[1], encoding="utf-8").read()
+page = sys.argv[3]
 checks = {
     "the comparison table": '<table class="compare">' in dom,
     "the metrics table": '<table class="metrics">' in dom,
-    "a method's section": "<h2>han</h2>" in dom,
 }
 svgs = len(re.findall(r"<svg[ >]", dom))
-checks["8 inline SVG plots (input + 3 methods, comb and curvature each)"] = svgs == 8
+imgs = len(re.findall(r'<img [^>]*src="data:image/png;base64,', dom))
+if page == "curve":
+    checks["a method's section"] = "<h2>han</h2>" in dom
+    checks["8 inline SVG plots (input + 3 methods, comb and curvature each)"] = svgs == 8
+else:
+    checks["the methods' sections"] = "<h2>salvi</h2>" in dom and "<h2>eck-hadenfeld</h2>" in dom
+    checks["3 inline PNG pictures (input + 2 methods)"] = imgs == 3
 for what, ok in checks.items():
     if not ok:
-        sys.exit(f"check_report_browser: the loaded page lacks {what} ({svgs} svg elements)")
+        sys.exit(f"check_report_browser: the {page} page lacks {what} ({svgs} svg, {imgs} img)")
 
 
 def png_pixels(path):
@@ -117,6 +123,17 @@ total = width * height
 if ink < total // 100 or coloured < 2000:
     sys.exit(f"check_report_browser: the screenshot looks blank: {ink} dark and {coloured} "
              f"coloured pixels of {total}")
-print(f"check_report_browser: ok: {svgs} plots in the DOM; screenshot {width}x{height}, "
-      f"{ink} dark pixels ({100 * ink / total:.1f}%), {coloured} coloured")
+print(f"check_report_browser: {page} page ok: {svgs} svg and {imgs} img plots in the DOM; "
+      f"screenshot {width}x{height}, {ink} dark pixels ({100 * ink / total:.1f}%), "
+      f"{coloured} coloured")
 EOF
+
+for page in curve surface; do
+  html=$out/report.html
+  [ "$page" = surface ] && html=$out/surface-report.html
+  url="file://$(realpath "$html")"
+  chrome --dump-dom "$url" >"$out/$page-dom.html" 2>/dev/null
+  chrome --screenshot="$out/$page-screenshot.png" --window-size=1200,2000 "$url" >/dev/null 2>&1
+  test -s "$out/$page-screenshot.png"
+  python3 "$profile/check.py" "$out/$page-dom.html" "$out/$page-screenshot.png" "$page"
+done

@@ -4,12 +4,12 @@
 # toolchain and cargo-fuzz (`cargo install cargo-fuzz`). Exits non-zero on the first crash;
 # the crashing input is left in fuzz/artifacts/TARGET/ and the log in fuzz/artifacts/TARGET.log.
 # With FUZZ_SCRATCH=1 (CI) new inputs go to a temporary directory and the corpora stay as
-# committed.
+# committed. With FUZZ_BUILT=1 the targets are taken as built (`cargo +nightly fuzz build -O`).
 set -euo pipefail
 cd "$(dirname "$0")/../fuzz"
 seconds=${1:-60}
 targets=${TARGETS:-"text_reader json_points json_curve fair_methods"}
-cargo +nightly fuzz build -O
+[ -n "${FUZZ_BUILT:-}" ] || cargo +nightly fuzz build -O
 mkdir -p artifacts
 for t in $targets; do
   mkdir -p "corpus/$t"

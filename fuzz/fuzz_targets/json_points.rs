@@ -28,7 +28,7 @@ fuzz_target!(|data: &[u8]| {
         )
         .unwrap();
         let back = io::parse_points(
-            text.as_bytes(),
+            &text,
             Format::Json,
             Path::new("f.json"),
             &ReadOptions::DEFAULT,

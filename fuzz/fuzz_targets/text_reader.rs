@@ -23,7 +23,7 @@ fuzz_target!(|data: &[u8]| {
             // What is read writes back and reads back bit for bit.
             let text = io::encode_points(Path::new("f.csv"), pts, false, None).unwrap();
             let back =
-                io::parse_points(text.as_bytes(), Format::Text, Path::new("f.csv"), &options)
+                io::parse_points(&text, Format::Text, Path::new("f.csv"), &options)
                     .unwrap();
             assert_eq!(back.seq.points(), pts);
         }

@@ -8,9 +8,9 @@ use batten::FairnessMetrics;
 
 use crate::AnalyzeArgs;
 use crate::failure::Failure;
-use crate::input;
 use crate::output::{self, sig};
 use crate::spinner::Spinner;
+use crate::{formats, input};
 
 /// Significant digits of real numbers in the table.
 const DIGITS: usize = 6;
@@ -20,8 +20,8 @@ const DIGITS: usize = 6;
 /// # Errors
 /// Bad input (exit 2); a metric that cannot be computed (exit 1).
 pub fn run(args: &AnalyzeArgs) -> Result<ExitCode, Failure> {
-    let data = input::read(&args.input, args.closed)?;
-    let name = args.input.display().to_string();
+    let data = input::read_picked(&args.input, args.closed, &args.pick)?;
+    let name = formats::display_name(&args.input).display().to_string();
     let spinner = Spinner::start(format!("analysing {} points", data.seq.len()));
     let metrics = FairnessMetrics::of_seq(&data.seq)
         .map_err(|e| Failure::from_batten(&format!("{name}: cannot analyse"), e))?;

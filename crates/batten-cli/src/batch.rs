@@ -12,6 +12,9 @@
 //! does not remove what an earlier run wrote under its name: the summary tells which results
 //! are from this run.
 //!
+//! A DXF file gives one row per curve entity (`FILE#HANDLE`) and one DXF back, each faired
+//! entity replaced in place ([`batten::io::DxfDrawing`]), with a list of reports.
+//!
 //! Exit codes: 0 when every file was faired within its tolerance; 2 when an input was
 //! unreadable or invalid (or on a usage error); otherwise 1 when a fairing failed, missed its
 //! tolerance, or an output could not be written.
@@ -29,7 +32,7 @@ use std::sync::{Arc, Mutex};
 use anyhow::anyhow;
 use batten::FairOptions;
 use batten::fair::{self, EndFix, FairMethod, FairReport};
-use batten::io::{self, Format, IoError, format_f64};
+use batten::io::{self, Format, IoError, ReadOptions, Source, format_f64};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
@@ -58,8 +61,9 @@ const REPORT_SUFFIX: &str = ".report.json";
 /// Arguments of `batten batch`.
 #[derive(Debug, Args)]
 pub struct BatchArgs {
-    /// Point files, directories (their .csv, .txt and .json files, by name; not recursive), or
-    /// quoted patterns with * and ? in the file name ("hull/frame-*.csv")
+    /// Point files, directories (their .csv, .txt, .json, .dxf, .igs and .svg files, by name;
+    /// not recursive), or quoted patterns with * and ? in the file name ("hull/frame-*.csv").
+    /// A DXF file is faired entity by entity into one DXF
     #[arg(value_name = "INPUT", required = true)]
     inputs: Vec<PathBuf>,
     /// Directory for the faired points (same file names and formats) and the reports
@@ -234,20 +238,22 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
         .build()
         .map_err(|e| Failure::failed(anyhow!("cannot start worker threads: {e}")))?;
     let bar = progress_bar(jobs.len());
-    // The rows of the files that have finished, for the summary an interrupt leaves.
-    let finished: Arc<Mutex<Vec<Option<Row>>>> = Arc::new(Mutex::new(vec![None; jobs.len()]));
+    // The rows of the files that have finished (a DXF file gives one per curve), for the
+    // summary an interrupt leaves.
+    let finished: Arc<Mutex<Vec<Option<Vec<Row>>>>> = Arc::new(Mutex::new(vec![None; jobs.len()]));
     if let (Some(path), Some(format)) = (&args.summary, summary_format) {
         let (finished, jobs, path) = (Arc::clone(&finished), jobs.clone(), path.clone());
         signals::set_last_word(move || {
             let slots = std::mem::take(&mut *finished.lock().unwrap_or_else(|e| e.into_inner()));
             let done = slots.iter().filter(|r| r.is_some()).count();
+            let files = slots.len();
             let rows: Vec<Row> = slots
                 .into_iter()
                 .zip(&jobs)
-                .map(|(row, job)| {
-                    row.unwrap_or_else(|| {
+                .flat_map(|(rows, job)| {
+                    rows.unwrap_or_else(|| {
                         let why = "batch interrupted before this file finished".to_string();
-                        Row::new(job, Status::Interrupted, Some(why), None, None)
+                        vec![Row::new(job, Status::Interrupted, Some(why), None, None)]
                     })
                 })
                 .collect();
@@ -262,7 +268,7 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
                     Ok(()) => format!(
                         "summary of the {done} of {} that finished written to {}, the others \
                          marked interrupted",
-                        output::count(rows.len(), "file"),
+                        output::count(files, "file"),
                         path.display()
                     ),
                     Err(e) => format!("summary not written: {e}"),
@@ -271,21 +277,23 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
         });
     }
     let rows: Vec<Row> = pool.install(|| {
-        jobs.par_iter()
+        let per_job: Vec<Vec<Row>> = jobs
+            .par_iter()
             .enumerate()
             .map(|(i, job)| {
-                let row = fair_one(job, method, &options);
+                let rows = fair_one(job, method, &options);
                 if let Some(slot) = finished
                     .lock()
                     .unwrap_or_else(|e| e.into_inner())
                     .get_mut(i)
                 {
-                    *slot = Some(row.clone());
+                    *slot = Some(rows.clone());
                 }
                 bar.inc(1);
-                row
+                rows
             })
-            .collect()
+            .collect();
+        per_job.into_iter().flatten().collect()
     });
     bar.finish_and_clear();
 
@@ -312,10 +320,16 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
     let count = |s: Status| rows.iter().filter(|r| r.status == s).count();
     let (ok, exceeded) = (count(Status::Ok), count(Status::ToleranceExceeded));
     let (failed, invalid) = (count(Status::Failed), count(Status::InvalidInput));
+    // A DXF file gives a row per curve entity.
+    let curves = if rows.len() == jobs.len() {
+        String::new()
+    } else {
+        format!(", {} curves", rows.len())
+    };
     output::note(&format!(
-        "batch: {}: {ok} ok, {exceeded} tolerance exceeded, {failed} failed, \
+        "batch: {}{curves}: {ok} ok, {exceeded} tolerance exceeded, {failed} failed, \
          {invalid} invalid input; results in {}",
-        output::count(rows.len(), "file"),
+        output::count(jobs.len(), "file"),
         args.out_dir.display()
     ));
     Ok(if invalid > 0 {
@@ -388,11 +402,19 @@ fn progress_bar(len: usize) -> ProgressBar {
     bar
 }
 
-/// Read, fair and write one file. Never fails: every problem becomes the row's status and
-/// error. A panic in the library is caught so that one bad curve cannot end the batch.
-fn fair_one(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> Row {
-    match panic::catch_unwind(AssertUnwindSafe(|| fair_one_inner(job, method, options))) {
-        Ok(row) => row,
+/// Read, fair and write one file: one row, or one per curve entity of a DXF file. Never
+/// fails: every problem becomes a row's status and error. A panic in the library is caught
+/// so that one bad curve cannot end the batch.
+fn fair_one(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> Vec<Row> {
+    let run = || {
+        if Format::from_path(&job.input).ok() == Some(Format::Dxf) {
+            fair_dxf(job, method, options)
+        } else {
+            vec![fair_one_inner(job, method, options)]
+        }
+    };
+    match panic::catch_unwind(AssertUnwindSafe(run)) {
+        Ok(rows) => rows,
         Err(payload) => {
             let why = payload
                 .downcast_ref::<&str>()
@@ -404,9 +426,164 @@ fn fair_one(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> Row {
                 job.input.display(),
                 method.name()
             );
-            Row::new(job, Status::Failed, Some(message), None, None)
+            vec![Row::new(job, Status::Failed, Some(message), None, None)]
         }
     }
+}
+
+/// The report of one entity of a DXF file, in the file's `NAME.report.json` list.
+#[derive(Serialize)]
+struct EntityReport<'a> {
+    handle: &'a str,
+    layer: Option<&'a str>,
+    kind: &'a str,
+    report: &'a FairReport,
+}
+
+/// Fair every curve entity of a DXF file and write the drawing back once, each faired
+/// entity's geometry replaced in place (handle, layer, z and every other entity kept), with
+/// `NAME.report.json` holding a list of `{handle, layer, kind, report}`. One row per entity,
+/// named `FILE#HANDLE`; an entity that cannot be taken or faired is a row and stays as it was
+/// in the output. Nothing is written when no entity was faired.
+fn fair_dxf(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> Vec<Row> {
+    let file = job.input.display().to_string();
+    let mut drawing = match io::DxfDrawing::read(&job.input) {
+        Ok(d) => d,
+        Err(e) => {
+            return vec![Row::new(
+                job,
+                Status::InvalidInput,
+                Some(e.to_string()),
+                None,
+                None,
+            )];
+        }
+    };
+    let curves = drawing.curves(&ReadOptions::default());
+    if curves.is_empty() {
+        let message = format!("{file}: no LWPOLYLINE, POLYLINE or SPLINE entity");
+        return vec![Row::new(
+            job,
+            Status::InvalidInput,
+            Some(message),
+            None,
+            None,
+        )];
+    }
+    let mut rows = Vec::with_capacity(curves.len());
+    let mut faired_all = Vec::new();
+    for c in &curves {
+        let handle = c.origin.name.clone().unwrap_or_default();
+        let label = format!("{file}#{handle}");
+        let row = |status, error, points, report| {
+            let mut r = Row::new(job, status, error, points, report);
+            r.file.clone_from(&label);
+            r
+        };
+        let source = match &c.source {
+            Ok(s) => s,
+            Err(e) => {
+                rows.push(row(Status::InvalidInput, Some(e.to_string()), None, None));
+                continue;
+            }
+        };
+        let (result, points) = match source {
+            Source::Points(d) => {
+                if let Err(f) = input::check(method, d.seq.is_closed(), options) {
+                    let message = format!("{label}: {}", f.error);
+                    rows.push(row(
+                        Status::InvalidInput,
+                        Some(message),
+                        Some(d.seq.len()),
+                        None,
+                    ));
+                    continue;
+                }
+                (fair::fair_with(method, &d.seq, options), d.seq.len())
+            }
+            Source::Curve(curve) => {
+                if !method.run_curve_supported() {
+                    let message = format!(
+                        "{label}: {} with control points is a B-spline; method {} takes points",
+                        c.kind,
+                        method.name()
+                    );
+                    rows.push(row(Status::InvalidInput, Some(message), None, None));
+                    continue;
+                }
+                (
+                    fair::fair_curve(method.name(), curve, options),
+                    curve.control_points().len(),
+                )
+            }
+        };
+        let faired = match result {
+            Ok(f) => f,
+            Err(e) => {
+                let f =
+                    Failure::from_batten(&format!("{label}: method {} failed", method.name()), e);
+                let status = if f.exit_code() == ExitCode::from(EXIT_USAGE) {
+                    Status::InvalidInput
+                } else {
+                    Status::Failed
+                };
+                rows.push(row(status, Some(f.error.to_string()), Some(points), None));
+                continue;
+            }
+        };
+        let geometry = match (source, &faired.curve) {
+            (Source::Curve(_), Some(curve)) => io::DxfGeometry::Curve(curve),
+            _ => io::DxfGeometry::Points(&faired.points),
+        };
+        if let Err(e) = drawing.replace(&handle, geometry) {
+            rows.push(row(Status::Failed, Some(e.to_string()), Some(points), None));
+            continue;
+        }
+        let report = &faired.report;
+        let (status, error) = if report.tolerance_met {
+            (Status::Ok, None)
+        } else {
+            (
+                Status::ToleranceExceeded,
+                Some(format!(
+                    "{label}: tolerance {} not met: a point moved {}; output and report written anyway",
+                    report.tolerance.map_or_else(String::new, format_f64),
+                    sig(report.max_displacement, DIGITS),
+                )),
+            )
+        };
+        rows.push(row(status, error, Some(points), Some(report)));
+        faired_all.push((c, faired));
+    }
+    if faired_all.is_empty() {
+        return rows;
+    }
+    let reports: Vec<EntityReport<'_>> = faired_all
+        .iter()
+        .map(|(c, f)| EntityReport {
+            handle: c.origin.name.as_deref().unwrap_or_default(),
+            layer: c.origin.layer.as_deref(),
+            kind: c.kind,
+            report: &f.report,
+        })
+        .collect();
+    // The reports and the drawing as one set, the reports first (as `batten fair` does).
+    let written = drawing.to_bytes().map_err(|e| e.to_string()).and_then(|b| {
+        let mut json = serde_json::to_string_pretty(&reports)
+            .map_err(|e| format!("cannot encode the reports: {e}"))?;
+        json.push('\n');
+        io::write_atomic_set(&[(&job.report, json.as_bytes()), (&job.output, &b)])
+            .map_err(|e| e.to_string())
+    });
+    if let Err(message) = written {
+        for r in &mut rows {
+            if matches!(r.status, Status::Ok | Status::ToleranceExceeded) {
+                r.status = Status::Failed;
+                r.error = Some(message.clone());
+            }
+        }
+    }
+    rows
 }
 
 fn fair_one_inner(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> Row {
@@ -446,7 +623,7 @@ fn fair_one_inner(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> 
             let report = fair_cmd::report_json(report).map_err(|f| f.error.to_string())?;
             io::write_atomic_set(&[
                 (&job.report, report.as_bytes()),
-                (&job.output, points.as_bytes()),
+                (&job.output, points.as_slice()),
             ])
             .map_err(|e| e.to_string())
         });
@@ -503,7 +680,7 @@ fn expand(args: &[PathBuf]) -> Result<Vec<PathBuf>, Failure> {
             let found = list_dir(dir, Some(pattern))?;
             if found.is_empty() {
                 return Err(Failure::usage(anyhow!(
-                    "{}: matches no .csv, .txt or .json file",
+                    "{}: matches no .csv, .txt, .json, .dxf, .igs or .svg file",
                     arg.display()
                 )));
             }
@@ -523,7 +700,7 @@ fn expand(args: &[PathBuf]) -> Result<Vec<PathBuf>, Failure> {
     }
     if inputs.is_empty() {
         return Err(Failure::usage(anyhow!(
-            "no .csv, .txt or .json files in {}",
+            "no .csv, .txt, .json, .dxf, .igs or .svg files in {}",
             args.iter()
                 .map(|a| a.display().to_string())
                 .collect::<Vec<_>>()

@@ -64,7 +64,9 @@ pub fn run(args: &CompareArgs) -> Result<ExitCode, Failure> {
     );
     base.validate().map_err(|e| Failure::from_batten("", e))?;
     let data = input::read(&args.input, args.closed)?;
-    let name = args.input.display().to_string();
+    let name = crate::formats::display_name(&args.input)
+        .display()
+        .to_string();
     let before = FairnessMetrics::of_seq(&data.seq)
         .map_err(|e| Failure::from_batten(&format!("{name}: cannot analyse"), e))?;
 

@@ -14,7 +14,6 @@ use batten::io;
 use clap::{Args, ValueEnum};
 
 use crate::failure::Failure;
-use crate::input;
 use crate::output;
 
 /// Decimals of the angle as the paper prints it (truncated, not rounded: Table 4).
@@ -53,7 +52,7 @@ pub struct EvaluateArgs {
     /// Print a JSON object instead of a table
     #[arg(long)]
     json: bool,
-    /// Number of ρ samples along the normalised arc length [default: max(41, 10 per segment + 1)]
+    /// Number of ρ samples along the normalised arc length, at most 100000 [default: max(41, 10 per segment + 1)]
     #[arg(long, value_name = "N")]
     samples: Option<usize>,
     /// Cap on |ρ| in data units [default: 100 × the curve length]
@@ -72,7 +71,9 @@ pub struct EvaluateArgs {
 /// # Errors
 /// Bad input or options (exit 2); an evaluation that cannot be computed (exit 1).
 pub fn run(args: &EvaluateArgs) -> Result<ExitCode, Failure> {
-    let name = args.input.display().to_string();
+    let name = crate::formats::display_name(&args.input)
+        .display()
+        .to_string();
     let mut opts = KuraganoOptions::default()
         .with_residual(match args.residual {
             ResidualArg::Rho => Residual::Rho,
@@ -91,19 +92,13 @@ pub fn run(args: &EvaluateArgs) -> Result<ExitCode, Failure> {
         opts = opts.with_rho_max(r);
     }
     let what = format!("{name}: cannot evaluate");
-    // A JSON file may hold a B-spline curve; anything else is a point list.
-    let curve = match io::Format::from_path(&args.input) {
-        Ok(io::Format::Json) => match io::read_curve_json(&args.input) {
-            Ok(c) => Some(c),
-            Err(io::IoError::PointsNotCurve { .. }) => None,
-            Err(e) => return Err(Failure::usage(e)),
-        },
-        _ => None,
-    };
-    let evaluation = match &curve {
-        Some(c) => kuragano::evaluate(c, &opts),
-        None => {
-            let data = input::read(&args.input, false)?;
+    // A B-spline (JSON, DXF SPLINE, IGES 126, SVG Béziers) or a point list.
+    let format = crate::formats::format_of(&args.input, None)?;
+    let source =
+        crate::formats::read_input(&args.input, format, false, &io::Pick::default())?.source;
+    let evaluation = match source {
+        io::Source::Curve(c) => kuragano::evaluate(&c, &opts),
+        io::Source::Points(data) => {
             if data.seq.is_closed() {
                 return Err(Failure::usage(anyhow!(
                     "{name}: the fairness evaluation needs an open curve"
@@ -158,10 +153,25 @@ fn table(name: &str, e: &Evaluation) -> String {
     match (e.best_degree, e.fairness) {
         (Some(d), Some(f)) => {
             let label = DEGREE_NAMES.get(d.wrapping_sub(1)).copied().unwrap_or("?");
-            let _ = writeln!(
+            let _ = write!(
                 s,
                 "  best: {label} (degree {d}), fairness {f:.COSINE_DECIMALS$}"
             );
+            let max = e
+                .degrees
+                .iter()
+                .filter_map(|r| r.correlation)
+                .fold(f64::NEG_INFINITY, f64::max);
+            if max > f {
+                // A tie (kuragano::TIE_TOLERANCE) went to the lower degree: say so.
+                let _ = write!(
+                    s,
+                    " (the lowest degree within {:e} of the largest correlation, \
+                     {max:.COSINE_DECIMALS$})",
+                    kuragano::TIE_TOLERANCE
+                );
+            }
+            let _ = writeln!(s);
         }
         _ => {
             let _ = writeln!(

@@ -5,15 +5,15 @@ use std::process::ExitCode;
 
 use anyhow::anyhow;
 use batten::fair::{self, FairReport};
-use batten::io::{self, Format, IoError, PointData, ReadOptions, format_f64};
+use batten::io::{self, Format, IoError, PointData, format_f64};
 use batten::spline::BSplineCurve;
 use batten::{Faired, PointSeq, analysis};
 
 use crate::FairArgs;
 use crate::failure::{EXIT_FAILED, Failure};
-use crate::input;
 use crate::output::{self, sig};
 use crate::spinner::Spinner;
+use crate::{formats, input};
 
 /// Significant digits in the summary line.
 const DIGITS: usize = 4;
@@ -37,54 +37,66 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         params,
     );
     input::check(method, args.closed, &options)?;
-    Format::from_path(&args.output).map_err(Failure::usage)?;
-    check_writable(&args.output)?;
+    let in_format = formats::format_of(&args.input, args.pick.format)?;
+    let out_format = formats::format_of(&args.output, args.pick.format)?;
+    let input_name = formats::display_name(&args.input);
+    args.pick
+        .check(in_format, &input_name.display().to_string())?;
+    let to_stdout = formats::is_stdio(&args.output);
+    if !to_stdout {
+        check_writable(&args.output)?;
+    }
     if let Some(report) = &args.report {
         check_writable(report)?;
     }
+    let curve_format = match &args.curve_out {
+        None => None,
+        Some(curve_out) => {
+            let f = Format::from_path(curve_out)
+                .ok()
+                .filter(|f| *f != Format::Text);
+            let Some(f) = f else {
+                return Err(Failure::usage(anyhow!(
+                    "{}: --curve-out writes a B-spline: give a .json, .dxf, .igs or .svg file",
+                    curve_out.display()
+                )));
+            };
+            check_writable(curve_out)?;
+            if !formats::is_stdio(&args.input) {
+                io::ensure_distinct(&args.input, curve_out).map_err(Failure::usage)?;
+            }
+            let clash = same_path(curve_out, &args.output)
+                || args
+                    .report
+                    .as_deref()
+                    .is_some_and(|r| same_path(curve_out, r));
+            if clash {
+                return Err(Failure::usage(anyhow!(
+                    "--curve-out {} names another output too",
+                    curve_out.display()
+                )));
+            }
+            Some(f)
+        }
+    };
 
-    if let Some(curve_out) = &args.curve_out {
-        if !matches!(Format::from_path(curve_out), Ok(Format::Json)) {
-            return Err(Failure::usage(anyhow!(
-                "{}: --curve-out writes a B-spline as JSON: give a .json file",
-                curve_out.display()
-            )));
-        }
-        check_writable(curve_out)?;
-        io::ensure_distinct(&args.input, curve_out).map_err(Failure::usage)?;
-        let clash = same_path(curve_out, &args.output)
-            || args
-                .report
-                .as_deref()
-                .is_some_and(|r| same_path(curve_out, r));
-        if clash {
-            return Err(Failure::usage(anyhow!(
-                "--curve-out {} names another output too",
-                curve_out.display()
-            )));
-        }
-    }
-
-    // A B-spline JSON file is faired as a curve (control-point methods only).
-    let source = match io::read_points(
-        &args.input,
-        &ReadOptions::default().with_closed(args.closed),
-    ) {
-        Ok(data) => Source::Points(data),
-        Err(IoError::CurveNotPoints { .. }) => {
-            Source::Curve(io::read_curve_json(&args.input).map_err(Failure::usage)?)
-        }
-        Err(e) => return Err(Failure::usage(e)),
+    // A B-spline (JSON, DXF SPLINE, IGES 126, SVG Béziers) is faired as a curve
+    // (control-point methods only).
+    let read = formats::read_input(&args.input, in_format, args.closed, &args.pick.pick())?;
+    let origin = read.origin;
+    let source = match read.source {
+        io::Source::Points(d) => Source::Points(d),
+        io::Source::Curve(c) => Source::Curve(c),
     };
     match &source {
         // A JSON file can make the curve closed: check the method against that too.
         Source::Points(d) => fair::check_options(method, d.seq.is_closed(), &options)
-            .map_err(|e| Failure::from_batten(&args.input.display().to_string(), e))?,
+            .map_err(|e| Failure::from_batten(&input_name.display().to_string(), e))?,
         Source::Curve(_) if !method.run_curve_supported() => {
             return Err(Failure::usage(anyhow!(
                 "{}; method {} takes points (B-spline input: {})",
                 IoError::CurveNotPoints {
-                    path: args.input.clone()
+                    path: input_name.clone()
                 },
                 method.name(),
                 fair::methods()
@@ -97,9 +109,13 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         }
         Source::Curve(_) => {}
     }
-    io::ensure_distinct(&args.input, &args.output).map_err(Failure::usage)?;
+    if !formats::is_stdio(&args.input) && !to_stdout {
+        io::ensure_distinct(&args.input, &args.output).map_err(Failure::usage)?;
+    }
     if let Some(report) = &args.report {
-        io::ensure_distinct(&args.input, report).map_err(Failure::usage)?;
+        if !formats::is_stdio(&args.input) {
+            io::ensure_distinct(&args.input, report).map_err(Failure::usage)?;
+        }
         if same_path(report, &args.output) {
             return Err(Failure::usage(anyhow!(
                 "--report and --output both name {}",
@@ -108,7 +124,7 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         }
     }
 
-    let input_name = args.input.display();
+    let input_name = input_name.display();
     let failed =
         |e| Failure::from_batten(&format!("{input_name}: method {} failed", method.name()), e);
     let spinner = Spinner::start(format!("fairing with {}", method.name()));
@@ -127,24 +143,46 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         .tangents
         .as_deref()
         .or(data.and_then(|d| d.tangents.as_deref()));
+    let out_name = formats::display_name(&args.output);
+    let bytes = match (out_format, faired.curve.as_ref()) {
+        // SVG holds the faired B-spline itself when it can (a method's cubic).
+        (Format::Svg, Some(c)) if io::svg_can_hold(c) => {
+            io::format_curve(out_format, &out_name, c, closed, &origin)
+        }
+        _ => io::format_points(
+            out_format,
+            &out_name,
+            &faired.points,
+            closed,
+            tangents,
+            &origin,
+        ),
+    }
+    .map_err(Failure::failed)?;
     // One set, all or none: the report and the curve first, the points last, so that a
-    // faired file beside an older report cannot happen (see `io::write_atomic_set`).
-    let points = io::encode_points(&args.output, &faired.points, closed, tangents)
-        .map_err(Failure::failed)?;
+    // faired file beside an older report cannot happen (see `io::write_atomic_set`). Points
+    // for standard output go there once the files are written.
     let report = match &args.report {
-        Some(path) => Some((path, report_json(&faired.report)?)),
+        Some(path) => Some((path, report_json(&faired.report)?.into_bytes())),
         None => None,
     };
-    let curve = match &args.curve_out {
-        Some(path) => Some((path, curve_json(path, &faired, closed)?)),
-        None => None,
+    let curve = match (&args.curve_out, curve_format) {
+        (Some(path), Some(format)) => {
+            Some((path, curve_bytes(path, format, &faired, closed, &origin)?))
+        }
+        _ => None,
     };
     let mut set: Vec<(&Path, &[u8])> = Vec::with_capacity(3);
-    set.extend(report.iter().map(|(p, t)| (p.as_path(), t.as_bytes())));
-    set.extend(curve.iter().map(|(p, t)| (p.as_path(), t.as_bytes())));
-    set.push((&args.output, points.as_bytes()));
+    set.extend(report.iter().map(|(p, b)| (p.as_path(), b.as_slice())));
+    set.extend(curve.iter().map(|(p, b)| (p.as_path(), b.as_slice())));
+    if !to_stdout {
+        set.push((&args.output, &bytes));
+    }
     io::write_atomic_set(&set).map_err(Failure::failed)?;
     spinner.finish();
+    if to_stdout {
+        formats::write_output(&args.output, &bytes)?;
+    }
 
     output::note(&summary(&faired.report, data));
     if faired.report.tolerance_met {
@@ -186,9 +224,16 @@ enum Source {
     Curve(BSplineCurve),
 }
 
-/// The faired curve as B-spline JSON: the method's own B-spline, or the analysis curve (the
-/// C² cubic through the faired points) converted exactly to B-spline form.
-fn curve_json(path: &Path, faired: &Faired, closed: bool) -> Result<String, Failure> {
+/// The faired curve (JSON, DXF SPLINE, IGES 126 or SVG) as bytes: the method's own
+/// B-spline, or the analysis curve (the C² cubic through the faired points) converted
+/// exactly to B-spline form.
+fn curve_bytes(
+    path: &Path,
+    format: Format,
+    faired: &Faired,
+    closed: bool,
+    origin: &io::Origin,
+) -> Result<Vec<u8>, Failure> {
     let converted;
     let curve = match &faired.curve {
         Some(c) => c,
@@ -203,10 +248,15 @@ fn curve_json(path: &Path, faired: &Faired, closed: bool) -> Result<String, Fail
             &converted
         }
     };
-    let mut json = serde_json::to_string_pretty(curve)
-        .map_err(|e| Failure::failed(anyhow!("cannot encode the curve: {e}")))?;
-    json.push('\n');
-    Ok(json)
+    match io::format_curve(format, path, curve, closed, origin) {
+        Ok(b) => Ok(b),
+        // SVG holds Béziers of degree 3 at most: the C² cubic through the faired points.
+        Err(_) if format == Format::Svg => {
+            io::format_points(format, path, &faired.points, closed, None, origin)
+                .map_err(Failure::failed)
+        }
+        Err(e) => Err(Failure::failed(e)),
+    }
 }
 
 /// The report as pretty JSON.

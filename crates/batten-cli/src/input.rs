@@ -6,17 +6,33 @@ use std::path::Path;
 use anyhow::anyhow;
 use batten::FairOptions;
 use batten::fair::{self, EndFix, FairMethod};
-use batten::io::{self, PointData, ReadOptions};
+use batten::io::{self, PointData, Source};
 
 use crate::failure::Failure;
+use crate::formats::{self, PickArgs};
 
-/// Read and validate the input point file; every problem is a usage error (exit 2) naming
-/// the file and line.
+/// Read and validate the input points (any format by extension, `-` for standard input as
+/// CSV); every problem is a usage error (exit 2) naming the file and line.
 ///
 /// # Errors
 /// [`Failure::usage`] with the [`io::IoError`] message.
 pub fn read(path: &Path, closed: bool) -> Result<PointData, Failure> {
-    io::read_points(path, &ReadOptions::default().with_closed(closed)).map_err(Failure::usage)
+    read_picked(path, closed, &PickArgs::default())
+}
+
+/// [`read`], with `--format` and the flags that pick one curve of a DXF, IGES or SVG file.
+///
+/// # Errors
+/// [`Failure::usage`]: the file's problem, a flag for another format, or a B-spline (which
+/// the command does not take).
+pub fn read_picked(path: &Path, closed: bool, pick: &PickArgs) -> Result<PointData, Failure> {
+    let format = formats::format_of(path, pick.format)?;
+    let name = formats::display_name(path);
+    pick.check(format, &name.display().to_string())?;
+    match formats::read_input(path, format, closed, &pick.pick())?.source {
+        Source::Points(d) => Ok(d),
+        Source::Curve(_) => Err(Failure::usage(io::IoError::CurveNotPoints { path: name })),
+    }
 }
 
 /// Parse `--set KEY=VALUE` arguments. Keys and values are trimmed; the key must be

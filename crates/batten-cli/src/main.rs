@@ -16,6 +16,8 @@ mod compare;
 mod evaluate;
 mod failure;
 mod fair_cmd;
+mod figure;
+mod formats;
 mod input;
 mod methods;
 mod output;
@@ -23,6 +25,9 @@ mod plot;
 mod report;
 mod signals;
 mod spinner;
+mod surface_cmd;
+mod surface_plot;
+mod surface_report;
 mod usage;
 
 use std::path::PathBuf;
@@ -51,7 +56,7 @@ enum Command {
     /// Fair the points and write them (same count and order) to OUTPUT
     Fair(FairArgs),
     /// List the fairing methods, their descriptions and parameters
-    Methods,
+    Methods(methods::MethodsArgs),
     /// Run several methods on the same input and tabulate the results (Han et al.'s Table 1)
     Compare(CompareArgs),
     /// Draw the curvature comb, κ(s), ρ(s) or x–c plot as SVG, the faired curve over the input
@@ -62,12 +67,18 @@ enum Command {
     Batch(batch::BatchArgs),
     /// Kuragano & Yamaguchi's fairness evaluation: which polynomial ρ(s) the curve follows best
     Evaluate(evaluate::EvaluateArgs),
+    /// Curvature ranges, umbilics and the fairness measure of a B-spline surface (JSON)
+    AnalyzeSurface(surface_cmd::AnalyzeSurfaceArgs),
+    /// Fair a B-spline surface (JSON) within a tolerance: salvi or eck-hadenfeld
+    FairSurface(surface_cmd::FairSurfaceArgs),
+    /// Curvature maps, isophotes, zebra and deviation of a B-spline surface (PNG or SVG)
+    PlotSurface(surface_plot::PlotSurfaceArgs),
 }
 
 /// Arguments of `batten analyze`.
 #[derive(Debug, Args)]
 struct AnalyzeArgs {
-    /// Point file (.csv, .txt or .json)
+    /// Point file (.csv, .txt, .json, .dxf, .igs, .svg; `-` reads standard input)
     #[arg(value_name = "INPUT")]
     input: PathBuf,
     /// Print a JSON object instead of a table
@@ -76,17 +87,20 @@ struct AnalyzeArgs {
     /// The points form a closed curve (the last connects to the first; do not repeat it)
     #[arg(long)]
     closed: bool,
+    #[command(flatten)]
+    pick: formats::PickArgs,
 }
 
 /// Arguments of `batten fair`.
 #[derive(Debug, Args)]
 struct FairArgs {
-    /// Point file (.csv, .txt or .json), or a B-spline curve as JSON ({"degree", "knots",
-    /// "control_points", "weights"}) for the methods that work on control points
+    /// Point file (.csv, .txt, .json, .dxf, .igs, .svg; `-` reads standard input), or a
+    /// B-spline (JSON {"degree", "knots", "control_points", "weights"}, a DXF SPLINE, IGES
+    /// entity 126, SVG Béziers) for the methods that work on control points
     #[arg(value_name = "INPUT")]
     input: PathBuf,
-    /// Where to write the faired points; the format follows the extension (.csv, .txt, .json).
-    /// Never the input file
+    /// Where to write the faired points; the format follows the extension (.csv, .txt, .json,
+    /// .dxf, .igs, .svg); `-` writes standard output. Never the input file
     #[arg(short, long, value_name = "OUTPUT")]
     output: PathBuf,
     /// Fairing method (see `batten methods`) [default: the first listed there]
@@ -108,9 +122,10 @@ struct FairArgs {
     /// Write the fairing report (JSON) to this file
     #[arg(long, value_name = "R.json")]
     report: Option<PathBuf>,
-    /// Also write the faired curve as a B-spline (JSON: degree, knots, control_points): the
-    /// method's own curve, or the C² cubic through the faired points for point methods
-    #[arg(long, value_name = "FILE.json")]
+    /// Also write the faired curve as a B-spline (.json: degree, knots, control_points; .dxf:
+    /// SPLINE; .igs: entity 126; .svg: Bézier path): the method's own curve, or the C² cubic
+    /// through the faired points for point methods
+    #[arg(long, value_name = "FILE")]
     curve_out: Option<PathBuf>,
     /// A method parameter, KEY=VALUE (repeat for several; see `batten methods`)
     #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -118,6 +133,8 @@ struct FairArgs {
     /// The points form a closed curve (a JSON file can say so with "closed": true)
     #[arg(long)]
     closed: bool,
+    #[command(flatten)]
+    pick: formats::PickArgs,
 }
 
 /// Output format of `batten compare`.
@@ -176,12 +193,15 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Analyze(a) => analyze::run(&a),
         Command::Fair(a) => fair_cmd::run(&a),
-        Command::Methods => methods::run(),
+        Command::Methods(a) => methods::run(&a),
         Command::Compare(a) => compare::run(&a),
         Command::Plot(a) => plot::run(&a),
         Command::Report(a) => report::run(&a),
         Command::Batch(a) => batch::run(&a),
         Command::Evaluate(a) => evaluate::run(&a),
+        Command::AnalyzeSurface(a) => surface_cmd::analyze(&a),
+        Command::FairSurface(a) => surface_cmd::fair(&a),
+        Command::PlotSurface(a) => surface_plot::run(&a),
     };
     match result {
         Ok(code) => code,

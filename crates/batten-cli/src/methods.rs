@@ -1,19 +1,39 @@
-//! `batten methods`: the registry, for people.
+//! `batten methods`: the registry, for people, or as JSON for programs (`--json`: the
+//! library's [`fair::catalogue`], which the Python package's `batten.methods()` returns too).
 
 use std::fmt::Write as _;
 use std::process::ExitCode;
 
+use anyhow::anyhow;
 use batten::fair::{self, FairMethod};
+use clap::Args;
 
 use crate::failure::Failure;
 use crate::output;
+
+/// Arguments of `batten methods`.
+#[derive(Debug, Args)]
+pub struct MethodsArgs {
+    /// Print a JSON array (name, summary, closed_curves, bspline_input, parameters with name,
+    /// type, default and doc), the default method first
+    #[arg(long)]
+    json: bool,
+}
 
 /// Run `batten methods`.
 ///
 /// # Errors
 /// Only a failed write to stdout.
-pub fn run() -> Result<ExitCode, Failure> {
-    output::stdout(&listing(fair::methods(), fair::default_method()))?;
+pub fn run(args: &MethodsArgs) -> Result<ExitCode, Failure> {
+    let text = if args.json {
+        let mut s = serde_json::to_string_pretty(&fair::catalogue())
+            .map_err(|e| Failure::failed(anyhow!("cannot encode the methods: {e}")))?;
+        s.push('\n');
+        s
+    } else {
+        listing(fair::methods(), fair::default_method())
+    };
+    output::stdout(&text)?;
     Ok(ExitCode::SUCCESS)
 }
 

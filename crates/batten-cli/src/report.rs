@@ -31,7 +31,8 @@ const PLOT_SIZE: (f64, f64) = (570.0, 430.0);
 /// Arguments of `batten report`.
 #[derive(Debug, Args)]
 pub struct ReportArgs {
-    /// Point file (.csv, .txt or .json)
+    /// Point file (.csv, .txt or .json), or a B-spline surface (.json; then the methods are
+    /// the surface methods and the page shows curvature maps, isophotes and zebra)
     #[arg(value_name = "INPUT")]
     input: PathBuf,
     /// Where to write the page (.html). Never the input file
@@ -61,6 +62,15 @@ pub struct ReportArgs {
 /// Usage errors and bad input (exit 2, nothing written); a failed analysis, plot or write
 /// (exit 1). Methods that fail are reported on the page and make the exit code 1.
 pub fn run(args: &ReportArgs) -> Result<ExitCode, Failure> {
+    if crate::surface_report::is_surface_file(&args.input) {
+        return crate::surface_report::run(&crate::surface_report::SurfaceReportArgs {
+            input: &args.input,
+            output: &args.output,
+            methods: &args.methods,
+            tolerance: args.tolerance,
+            curve_options: args.fix_ends.is_some() || args.closed,
+        });
+    }
     let methods = compare::resolve(&args.methods)?;
     let base = input::options(
         args.tolerance,
@@ -71,7 +81,9 @@ pub fn run(args: &ReportArgs) -> Result<ExitCode, Failure> {
     base.validate().map_err(|e| Failure::from_batten("", e))?;
     check_output(&args.output, &["html", "htm"], &[args.input.as_path()])?;
     let data = input::read(&args.input, args.closed)?;
-    let name = args.input.display().to_string();
+    let name = crate::formats::display_name(&args.input)
+        .display()
+        .to_string();
     let before = FairnessMetrics::of_seq(&data.seq)
         .map_err(|e| Failure::from_batten(&format!("{name}: cannot analyse"), e))?;
 

@@ -345,7 +345,10 @@ fn files_and_patterns_as_inputs_keep_argument_order() {
     );
     // A pattern that matches nothing is a usage error; nothing is written.
     let o = batten(&["batch", s(&a.join("nope-*.csv")), "-o", s(&d.join("out2"))]);
-    assert_usage_error(&o, &["nope-*.csv: matches no .csv, .txt or .json file"]);
+    assert_usage_error(
+        &o,
+        &["nope-*.csv: matches no .csv, .txt, .json, .dxf, .igs or .svg file"],
+    );
     assert!(!d.join("out2").exists());
     // A missing file given by name is a row, not the end of the batch.
     let missing = d.join("missing.csv");
@@ -498,7 +501,7 @@ fn bad_options_exit_2_and_write_nothing() {
     let empty = d.join("empty");
     fs::create_dir(&empty).unwrap();
     let o = batten(&["batch", s(&empty), "-o", s(&out)]);
-    assert_usage_error(&o, &["no .csv, .txt or .json files in"]);
+    assert_usage_error(&o, &["no .csv, .txt, .json, .dxf, .igs or .svg files in"]);
     assert!(!out.exists());
 }
 

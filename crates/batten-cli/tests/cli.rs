@@ -769,21 +769,29 @@ fn compare_runs_mst_at_the_first_methods_displacement() {
 #[test]
 fn bundled_examples_are_valid_inputs() {
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/data");
-    let mut n = 0;
+    let (mut n, mut surfaces) = (0, 0);
     for entry in fs::read_dir(&data).unwrap() {
         let p = entry.unwrap().path();
         let ext = p.extension().and_then(|e| e.to_str()).unwrap_or("");
         if !matches!(ext, "csv" | "json") {
             continue;
         }
+        let name = p.file_name().unwrap().to_str().unwrap();
+        if name.starts_with("hood") {
+            // The B-spline surfaces (examples/data/README.md).
+            let o = batten(&["analyze-surface", "--json", s(&p)]);
+            assert_eq!(code(&o), 0, "{}: {}", s(&p), stderr(&o));
+            surfaces += 1;
+            continue;
+        }
         let o = batten(&["analyze", "--json", s(&p)]);
         assert_eq!(code(&o), 0, "{}: {}", s(&p), stderr(&o));
         let v: Value = serde_json::from_str(&stdout(&o)).unwrap();
-        let name = p.file_name().unwrap().to_str().unwrap();
         assert_eq!(v["closed"], name.starts_with("ellipse"), "{name}");
         n += 1;
     }
     assert_eq!(n, 12, "six curves, noisy and truth");
+    assert_eq!(surfaces, 2, "the hood and the dented hood");
 }
 
 /// `--fix-ends` alone is the position; `--fix-ends=tangent|curvature` holds more, and the

@@ -45,14 +45,16 @@ fn evaluate_json_has_the_documented_shape() {
     let fairness = v["fairness"].as_f64().unwrap();
     assert_eq!(fairness, degrees[best - 1]["correlation"].as_f64().unwrap());
     assert!(fairness > 0.999, "{fairness}");
-    // The best degree is the lowest within 1e-6 of the largest correlation.
+    // The best degree is the lowest within TIE_TOLERANCE of the largest correlation.
     let max = degrees
         .iter()
         .map(|d| d["correlation"].as_f64().unwrap())
         .fold(0.0, f64::max);
     let lowest = degrees
         .iter()
-        .position(|d| d["correlation"].as_f64().unwrap() >= max - 1e-6)
+        .position(|d| {
+            d["correlation"].as_f64().unwrap() >= max - batten::fair::kuragano::TIE_TOLERANCE
+        })
         .unwrap();
     assert_eq!(best, lowest + 1);
 }

@@ -29,6 +29,21 @@ pub enum Error {
         /// Index of the second of the two equal points.
         index: usize,
     },
+    /// Two consecutive points are closer than [`crate::geom::NEAR_DUPLICATE_REL`] of the
+    /// curve's size: their chord is rounding, not shape.
+    #[error(
+        "points {previous} and {index} (counting from 0) are {relative:.1e} of the curve's size \
+         apart, closer than {limit:e}: near-duplicate points",
+        limit = crate::geom::NEAR_DUPLICATE_REL
+    )]
+    NearDuplicate {
+        /// Index of the second of the two points.
+        index: usize,
+        /// Index of the first (the point before it, or the last of a closed curve).
+        previous: usize,
+        /// Their distance over the larger side of the bounding box.
+        relative: f64,
+    },
     /// Abscissae of a function spline are not strictly increasing.
     #[error("x values must be strictly increasing: x[{index}] <= x[{prev}]", prev = index - 1)]
     NotIncreasing {

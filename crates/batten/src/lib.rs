@@ -42,6 +42,7 @@ pub mod numeric;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod spline;
+pub mod surface;
 
 pub use analysis::FairnessMetrics;
 pub use curve::{Curve, CurveDeriv, Derivatives, Piecewise};

@@ -708,7 +708,12 @@ fn point_input_respects_the_tolerance() {
                 "{method} {tol}: {}",
                 r.max_displacement
             );
-            assert!(r.max_displacement > 0.0);
+            assert!(
+                r.max_displacement > 0.0,
+                "{method} {tol}: {:?} {:?}",
+                r.status,
+                r.notes
+            );
             assert_eq!(out.points.len(), 60);
             assert!(non_increasing(&r.history), "{method}");
             let curve = out.curve.as_ref().expect("curve");
@@ -716,7 +721,8 @@ fn point_input_respects_the_tolerance() {
             assert_eq!(curve.control_points().len(), 60);
             // The output points lie on the faired curve, in order.
             let (c0, c1) = curve.domain();
-            assert_eq!(out.points[0], curve.eval(c0));
+            // To rounding: salvi runs in the principal frame, and the curve is moved back.
+            assert!(out.points[0].distance(curve.eval(c0)) < 1e-12);
             assert!(out.points[59].distance(curve.eval(c1)) < 1e-12);
         }
         // The faired points are smoother than the input: fewer curvature sign changes.

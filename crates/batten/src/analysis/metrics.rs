@@ -225,9 +225,37 @@ pub fn analysis_curve(seq: &PointSeq) -> Result<ParametricCubic> {
 impl FairnessMetrics {
     /// Measure a validated point sequence.
     ///
+    /// The measurement runs on the points divided by [`crate::geom::unit_scale`] (a power of
+    /// two, so the division is exact) and the numbers are scaled back to data units, so that
+    /// coordinates of any magnitude are measured alike: the counts do not depend on the scale,
+    /// and each number scales with its power of length (an energy that does not fit in an
+    /// `f64` in data units is reported as infinite or zero, not as a failure).
+    ///
     /// # Errors
     /// The spline constructors' errors.
     pub fn of_seq(seq: &PointSeq) -> Result<FairnessMetrics> {
+        let s = crate::geom::unit_scale(seq.points());
+        if s == 1.0 {
+            return Self::measure(seq);
+        }
+        let unit = seq.with_points(crate::geom::scale_points(seq.points(), 1.0 / s))?;
+        Ok(Self::measure(&unit)?.rescaled(s))
+    }
+
+    /// The metrics of the same curve scaled by `s` (counts unchanged; each number times `s`
+    /// to its power of length).
+    pub fn rescaled(mut self, s: f64) -> FairnessMetrics {
+        self.strain_energy *= s.powi(-1);
+        self.variation_energy *= s.powi(-3);
+        self.max_curvature *= s.powi(-1);
+        self.gfi *= s.powi(-6);
+        self.max_third_derivative_jump *= s.powi(-2);
+        self.length *= s;
+        self
+    }
+
+    /// [`FairnessMetrics::of_seq`] in the coordinates as given.
+    fn measure(seq: &PointSeq) -> Result<FairnessMetrics> {
         let curve = analysis_curve(seq)?;
         let closed = seq.is_closed();
         let m = curve.num_spans();

@@ -435,6 +435,7 @@ fn run_cali(points: &[Point], s: &Settings) -> Result<Outcome> {
     parameters.insert("lambdas".into(), Value::Array(lambdas));
 
     Ok(Outcome {
+        solver: None,
         points: out,
         status,
         iterations: moves.len(),

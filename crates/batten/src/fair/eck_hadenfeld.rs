@@ -46,6 +46,7 @@
 
 use serde_json::Value;
 
+use super::clean::ControlCheck;
 use super::local::{
     self, DEFAULT_TABU_LENGTH, FIT_PARAMS, LocalReport, RecentList, RunningMax, clamp_point,
     movable_mask, resolve_tolerance, select_candidate,
@@ -110,6 +111,14 @@ pub struct EckHadenfeldParams {
     ///
     /// Default value: 1.
     pub held_ends: usize,
+    /// The data parameters of the per-move clean-curve check: a move is refused when it
+    /// gives the cubic through the curve's points at these parameters an inflection where
+    /// it had none, or raises its variation energy where it was clean (`clean.rs`). `None`:
+    /// no check. The method sets them from the fit unless [`FairOptions::keep_clean`] is
+    /// false.
+    ///
+    /// Default value: `None`.
+    pub clean_at: Option<Vec<f64>>,
 }
 
 impl EckHadenfeldParams {
@@ -122,6 +131,7 @@ impl EckHadenfeldParams {
         min_rel_decrease: DEFAULT_MIN_REL_DECREASE,
         free_ends: false,
         held_ends: 1,
+        clean_at: None,
     };
 
     /// Set the order l.
@@ -164,6 +174,12 @@ impl EckHadenfeldParams {
     /// Hold `k` control points at each end (see [`EckHadenfeldParams::held_ends`]).
     pub fn with_held_ends(mut self, k: usize) -> EckHadenfeldParams {
         self.held_ends = k;
+        self
+    }
+
+    /// Refuse moves that make the curve at `params` worse ([`EckHadenfeldParams::clean_at`]).
+    pub fn with_clean_at(mut self, params: Vec<f64>) -> EckHadenfeldParams {
+        self.clean_at = Some(params);
         self
     }
 }
@@ -433,7 +449,11 @@ pub fn fair_curve(
         original.len(),
         local::held_control_points(params.free_ends, params.held_ends),
     );
-    let (d, report) = fair_control_points(original, &gram, &movable, params, delta);
+    let check = params
+        .clean_at
+        .as_deref()
+        .and_then(|t| ControlCheck::new(curve, t));
+    let (d, report) = fair_control_points(original, &gram, &movable, params, delta, check);
     Ok((curve.with_control_points(d)?, report))
 }
 
@@ -445,6 +465,7 @@ fn fair_control_points(
     movable: &[bool],
     params: &EckHadenfeldParams,
     delta: f64,
+    mut check: Option<ControlCheck>,
 ) -> (Vec<Point>, LocalReport) {
     let n = original.len();
     let mut d = original.to_vec();
@@ -489,7 +510,15 @@ fn fair_control_points(
         };
         iterations += 1;
         let (c, g, clamped) = best_move(&d, j);
-        if g > 0.0 && c != d[j] {
+        let refused =
+            g > 0.0 && c != d[j] && check.as_mut().is_some_and(|k| k.refuses(j, c - d[j]));
+        if refused {
+            // Not a candidate again until a neighbour's move changes its optimum.
+            gain[j] = 0.0;
+        } else if g > 0.0 && c != d[j] {
+            if let Some(k) = check.as_mut() {
+                k.commit(j, c - d[j]);
+            }
             let old = d[j];
             let b = gram.coupling(&d, j);
             let gjj = gram.get(j, j);
@@ -541,6 +570,7 @@ fn fair_control_points(
             moves.len()
         ));
     }
+    notes.extend(check.as_ref().and_then(ControlCheck::note));
     let report = LocalReport {
         status,
         iterations,
@@ -646,6 +676,7 @@ fn run_fitted(
         min_rel_decrease: DEFAULT_MIN_REL_DECREASE,
         free_ends: fitted.free_ends,
         held_ends: fitted.held_ends,
+        clean_at: options.keep_clean.then(|| fitted.params.clone()),
     };
     let (faired, report) = fair_curve(&fitted.curve, &params)?;
     let points = local::output_points(&faired, &fitted, input, options.fix_ends.is_fixed());
@@ -674,6 +705,7 @@ fn outcome(
     insert_common(&mut parameters, &report);
     notes.extend(report.notes);
     Outcome {
+        solver: None,
         points,
         status: report.status,
         iterations: report.iterations,
@@ -757,8 +789,10 @@ fn run_closed(input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
         min_rel_decrease: DEFAULT_MIN_REL_DECREASE,
         free_ends: true,
         held_ends: 0,
+        // The periodic curve's moves are left to the final guard of the common path.
+        clean_at: None,
     };
-    let (d, report) = fair_control_points(&original, &gram, &vec![true; n], &params, delta);
+    let (d, report) = fair_control_points(&original, &gram, &vec![true; n], &params, delta, None);
     let ctrl: Vec<Point> = (0..n + PAD).map(|r| d[period_index(r, n)]).collect();
     let faired = wrapped.with_control_points(ctrl)?;
     let out: Vec<Point> = t.iter().map(|&tk| faired.eval(tk)).collect();

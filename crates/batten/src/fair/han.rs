@@ -818,6 +818,11 @@ pub struct Segment {
     params: SegmentParams,
     bounds: Option<(Vec<f64>, Vec<f64>)>,
     limited: bool,
+    /// Refuse moves that give the points more inflections or a higher variation energy near
+    /// them (the per-move clean-curve check, [`Segment::with_keep_clean`]).
+    keep_clean: bool,
+    /// Moves refused by that check.
+    refused: usize,
 }
 
 impl Segment {
@@ -852,11 +857,28 @@ impl Segment {
             params: SegmentParams::DEFAULT,
             bounds: None,
             limited: false,
+            keep_clean: false,
+            refused: 0,
         };
         seg.refresh_e(1, n - 2);
         seg.e_scale = SignScale::new(&seg.e);
         seg.set_floors(0.0);
         Ok(seg)
+    }
+
+    /// Refuse (`true`) or allow (`false`, the default) moves that give the polyline's
+    /// chord-length cubic more inflections or a higher variation energy `∫(dκ/ds)² ds`
+    /// near them. The check is local (a few points either side of a move) and, the cubic
+    /// being invariant under rigid motion, the same in the segment's frame as in the
+    /// plane. `Han` turns it on unless [`FairOptions::keep_clean`] is false.
+    pub fn with_keep_clean(mut self, keep: bool) -> Segment {
+        self.keep_clean = keep;
+        self
+    }
+
+    /// Moves refused by the clean-curve check so far.
+    pub fn refused_moves(&self) -> usize {
+        self.refused
     }
 
     /// Declare that the points carry the rounding of coordinates of magnitude up to
@@ -1450,6 +1472,16 @@ impl Segment {
         if applied[..len].iter().all(|d| *d == 0.0) {
             return None;
         }
+        if self.keep_clean {
+            let moved: Vec<(usize, Point)> = (0..len)
+                .map(|k| (start + k, Point::new(self.x[start + k], targets[k])))
+                .collect();
+            let (x, y) = (&self.x, &self.y);
+            if super::clean::move_is_worse_by(x.len(), false, |i| Point::new(x[i], y[i]), &moved) {
+                self.refused += 1;
+                return None;
+            }
+        }
         self.y[start..start + len].copy_from_slice(&targets[..len]);
         let w = self.resp.add_columns(start, &applied[..len], &mut self.c);
         self.c_scale.wrote(&self.c, w);
@@ -1767,6 +1799,8 @@ struct RunLog {
     skipped: Vec<(usize, usize)>,
     /// Segments that were too steep in their frame and were re-partitioned.
     refined: usize,
+    /// Moves refused by the clean-curve check.
+    refused: usize,
 }
 
 impl RunLog {
@@ -1795,6 +1829,7 @@ impl RunLog {
         self.limited |= later.limited;
         self.skipped.extend(later.skipped);
         self.refined += later.refined;
+        self.refused += later.refused;
     }
 }
 
@@ -1812,6 +1847,8 @@ struct PassCtx<'a> {
     /// last, which han never moves: 0, 1 (tangent) or 2 (curvature); and the point count.
     held: usize,
     points: usize,
+    /// Refuse moves that make the curve worse near them ([`FairOptions::keep_clean`]).
+    keep_clean: bool,
 }
 
 /// Fair one open sequence `cur` (whose input positions are `orig`) in place: partition with
@@ -1917,7 +1954,8 @@ fn fair_span(
     }
     let mut seg = Segment::new(xs.clone(), ys.clone())?
         .with_params(ctx.params.segment)?
-        .with_coordinate_scale(ctx.coord);
+        .with_coordinate_scale(ctx.coord)
+        .with_keep_clean(ctx.keep_clean);
     // Points held by --fix-ends (the second and third at each end of the curve).
     let held = |k: usize| {
         let g = index_of(k);
@@ -1953,6 +1991,7 @@ fn fair_span(
         moves += 1;
         log.record(ctx.pass, index_of(m.i), m);
     });
+    log.refused += seg.refused_moves();
     let faired = pts
         .iter()
         .zip(seg.y().iter().zip(&ys))
@@ -2028,6 +2067,7 @@ impl FairMethod for Han {
                     options.fix_ends.held().saturating_sub(1)
                 },
                 points: n,
+                keep_clean: options.keep_clean,
             };
             let moves = if closed {
                 // Cut the cycle at a point that moves from pass to pass (see the module docs).
@@ -2096,6 +2136,13 @@ impl FairMethod for Han {
                 log.skipped.len(),
                 list.join(", "),
                 if log.skipped.len() > 10 { ", …" } else { "" }
+            ));
+        }
+        if log.refused > 0 {
+            notes.push(format!(
+                "{} moves were refused because they would have added an inflection or raised \
+                 the variation energy near the moved points (the clean-curve check)",
+                log.refused
             ));
         }
         if log.refined > 0 {

@@ -610,6 +610,14 @@ pub(super) trait LocalProblem {
     fn commit(&mut self, i: usize, s: f64, changed: &mut Vec<usize>) -> Result<(usize, f64)>;
     /// The largest distance of a data point from its original position.
     fn max_displacement(&self) -> f64;
+    /// Whether applying the fraction `s` of the move planned at `i` would give the curve
+    /// more inflections or a higher variation energy near it (the per-move clean-curve
+    /// check, `clean.rs`); such a move is refused like one that cannot stay within the
+    /// tolerance. The default: no check.
+    fn worsens(&self, i: usize, s: f64) -> bool {
+        let _ = (i, s);
+        false
+    }
 }
 
 /// What [`drive`] did.
@@ -664,7 +672,7 @@ pub(super) fn drive(
         measure: initial_max,
         max_distance: 0.0,
     }];
-    let (mut scaled, mut skipped) = (0usize, 0usize);
+    let (mut scaled, mut skipped, mut refused) = (0usize, 0usize, 0usize);
     let mut blocked = vec![false; n];
     let (mut changed, mut open_values) = (Vec::new(), Vec::new());
     let status = loop {
@@ -690,6 +698,12 @@ pub(super) fn drive(
                 continue;
             }
         };
+        if p.worsens(i, s) {
+            open.set(i, f64::NEG_INFINITY);
+            blocked[i] = true;
+            refused += 1;
+            continue;
+        }
         if s < 1.0 {
             scaled += 1;
         }
@@ -734,6 +748,12 @@ pub(super) fn drive(
             "{skipped} time(s) the worst point could not move within the tolerance and the next-worst was tried"
         ));
     }
+    if refused > 0 {
+        notes.push(format!(
+            "{refused} move(s) were refused because they would have added an inflection or \
+             raised the variation energy near the point (the clean-curve check)"
+        ));
+    }
     match status {
         FairStatus::ToleranceLimited => notes.push(format!(
             "stopped: no point with a jump above epsilon = {epsilon:.6e} can move within the tolerance"
@@ -776,6 +796,8 @@ struct SplineState {
     disp: MaxTree,
     min_chord: f64,
     planned: Vec2,
+    /// Refuse moves that make the curve worse near them ([`FairOptions::keep_clean`]).
+    keep_clean: bool,
     sub: Vec<f64>,
     diag: Vec<f64>,
     sup: Vec<f64>,
@@ -807,6 +829,7 @@ impl SplineState {
             rule,
             closed,
             held: 1,
+            keep_clean: false,
             reparametrize: chord && reparametrize,
             r: points.to_vec(),
             m: vec![Vec2::ZERO; n],
@@ -850,19 +873,20 @@ impl SplineState {
         }
     }
 
-    /// Row `i` of the interpolation system (spec §2.1): `(sub, diag, sup, rhs)`.
+    /// Row `i` of the interpolation system (spec §2.1): `(sub, diag, sup, rhs)`. The end
+    /// rows `2·m₀ + m₁ = 3·(r₁ − r₀)/Δt₀` are multiplied by `Δt₀` so that every row is in
+    /// the same units (lengths, on the chord-length spline): otherwise, at coordinates of
+    /// 10¹⁴, the end pivots 2 would be below the solver's relative zero next to the
+    /// interior ones `2·(Δt_{i−1} + Δt_i)`.
     fn row(&self, i: usize) -> (f64, f64, f64, Vec2) {
         let n = self.n();
         if !self.closed && i == 0 {
-            return (0.0, 2.0, 1.0, (self.r[1] - self.r[0]) * (3.0 / self.dt[0]));
+            let d = self.dt[0];
+            return (0.0, 2.0 * d, d, (self.r[1] - self.r[0]) * 3.0);
         }
         if !self.closed && i == n - 1 {
-            return (
-                1.0,
-                2.0,
-                0.0,
-                (self.r[n - 1] - self.r[n - 2]) * (3.0 / self.dt[n - 2]),
-            );
+            let d = self.dt[n - 2];
+            return (d, 2.0 * d, 0.0, (self.r[n - 1] - self.r[n - 2]) * 3.0);
         }
         let (p, q) = (self.prev(i), self.next(i));
         let (a, b) = (self.dt[p], self.dt[i]);
@@ -1008,6 +1032,15 @@ impl LocalProblem for SplineState {
     fn max_displacement(&self) -> f64 {
         self.disp.max_value()
     }
+
+    fn worsens(&self, k: usize, s: f64) -> bool {
+        self.keep_clean
+            && super::clean::move_is_worse(
+                &self.r,
+                self.closed,
+                &[(k, self.r[k] + self.planned * s)],
+            )
+    }
 }
 
 /// The iteration limit: `max_iterations`, or [`DEFAULT_MOVES_PER_POINT`] per candidate.
@@ -1065,6 +1098,7 @@ fn run_points(
     let closed = input.is_closed();
     let mut state = SplineState::new(input.points(), closed, !uniform, reparametrize, rule)?;
     state.held = options.fix_ends.held().max(1);
+    state.keep_clean = options.keep_clean;
     let candidates = if closed {
         input.len()
     } else {
@@ -1094,6 +1128,7 @@ fn run_points(
     }
     parameters.insert("solve_half_width".into(), json!(SOLVE_HALF_WIDTH));
     Ok(Outcome {
+        solver: None,
         points: state.r,
         status: driven.status,
         iterations: driven.moves.len(),
@@ -1252,6 +1287,7 @@ pub fn fair_hermite(
     let driven = drive(&mut state, threshold, max_moves, options.tolerance)?;
     let parameters = driven_parameters(&driven, threshold, max_moves);
     Ok(Outcome {
+        solver: None,
         points: state.r,
         status: driven.status,
         iterations: driven.moves.len(),
@@ -1283,6 +1319,14 @@ pub struct Poliakoff;
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Energy;
 
+/// Parameters in data units of `kjellander` and their power of length: the jumps of the
+/// uniform spline's third derivative are lengths.
+const UNIFORM_LENGTH_PARAMS: &[(&str, i32)] = &[("epsilon", 1), ("initial_max_jump", 1)];
+
+/// Parameters in data units of `poliakoff` and `energy`: on the chord-length spline the
+/// third derivative has the unit 1/length².
+const CHORD_LENGTH_PARAMS: &[(&str, i32)] = &[("epsilon", -2), ("initial_max_jump", -2)];
+
 impl FairMethod for Kjellander {
     fn name(&self) -> &'static str {
         "kjellander"
@@ -1298,6 +1342,22 @@ impl FairMethod for Kjellander {
 
     fn supports_closed(&self) -> bool {
         true
+    }
+
+    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
+        Ok(super::guard::length_params_at_scale(
+            options,
+            UNIFORM_LENGTH_PARAMS,
+            s,
+        ))
+    }
+
+    fn report_params_at_scale(
+        &self,
+        parameters: &mut serde_json::Map<String, serde_json::Value>,
+        s: f64,
+    ) {
+        super::guard::report_length_params(parameters, UNIFORM_LENGTH_PARAMS, s);
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {
@@ -1324,6 +1384,22 @@ impl FairMethod for Poliakoff {
 
     fn supports_closed(&self) -> bool {
         true
+    }
+
+    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
+        Ok(super::guard::length_params_at_scale(
+            options,
+            CHORD_LENGTH_PARAMS,
+            s,
+        ))
+    }
+
+    fn report_params_at_scale(
+        &self,
+        parameters: &mut serde_json::Map<String, serde_json::Value>,
+        s: f64,
+    ) {
+        super::guard::report_length_params(parameters, CHORD_LENGTH_PARAMS, s);
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {
@@ -1355,6 +1431,22 @@ impl FairMethod for Energy {
 
     fn supports_closed(&self) -> bool {
         true
+    }
+
+    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
+        Ok(super::guard::length_params_at_scale(
+            options,
+            CHORD_LENGTH_PARAMS,
+            s,
+        ))
+    }
+
+    fn report_params_at_scale(
+        &self,
+        parameters: &mut serde_json::Map<String, serde_json::Value>,
+        s: f64,
+    ) {
+        super::guard::report_length_params(parameters, CHORD_LENGTH_PARAMS, s);
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {

@@ -10,8 +10,12 @@
 //! Adding a method: implement [`FairMethod`] in a file of its own under `fair/` and list it
 //! in [`methods`].
 
+pub mod band;
 pub mod cali;
+mod catalogue;
+mod clean;
 pub mod eck_hadenfeld;
+mod guard;
 pub mod han;
 pub mod kjellander;
 pub mod kuragano;
@@ -24,14 +28,20 @@ pub mod smoothing;
 
 use std::time::Instant;
 
+pub use band::Band;
 pub use cali::Cali;
+pub use catalogue::{MethodInfo, ParamInfo, ParamType, catalogue};
+pub use clean::LOCAL_CHECK_HALF_WIDTH;
 pub use eck_hadenfeld::EckHadenfeld;
+pub use guard::{CLEAN_SLACK_REL, METHOD_SCALE_RANGE_LOG2};
 pub use han::Han;
 pub use kjellander::{
     Energy, HermiteMove, Kjellander, KpRule, Poliakoff, fair_hermite, hermite_step,
 };
 pub use options::{AUTO_TOLERANCE_K, EndFix, FairOptions, MAX_ITERATIONS, ParamSpec};
-pub use report::{EndChanges, FairReport, FairStatus, HistoryRow, Move, ToleranceSource};
+pub use report::{
+    EndChanges, FairReport, FairStatus, HistoryRow, Move, SolverInfo, ToleranceSource,
+};
 pub use salvi::Salvi;
 pub use sapidis_farin::{SapidisFarin, remove_reinsert_knot};
 pub use smoothing::{Mst, Smoothing, SmoothingInfo, SmoothingSpline, SmoothingTrial};
@@ -62,6 +72,8 @@ pub struct Outcome {
     pub curve: Option<BSplineCurve>,
     /// Updated tangents, for methods that carry tangents (Hermite data).
     pub tangents: Option<Vec<Vec2>>,
+    /// The solver's figures, for methods that solve an optimisation problem.
+    pub solver: Option<SolverInfo>,
 }
 
 /// A fairing method. Implementations are stateless unit structs.
@@ -122,6 +134,33 @@ pub trait FairMethod: Sync {
         let _ = options;
         Ok(AUTO_TOLERANCE_K)
     }
+
+    /// Whether the clean-curve guard applies ([`FairOptions::keep_clean`]): `true` (the
+    /// default) for every method but the csaps baseline `mst`.
+    fn keeps_clean(&self) -> bool {
+        true
+    }
+
+    /// The options for a run on the coordinates divided by `s` (a power of two, see
+    /// [`METHOD_SCALE_RANGE_LOG2`]): parameters given in data units converted. The common
+    /// path divides the tolerance itself. The default: no parameter in data units.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a value that cannot be converted.
+    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
+        let _ = s;
+        Ok(options.clone())
+    }
+
+    /// Convert the reported parameters of a run on the coordinates divided by `s` back to
+    /// data units, where the method has some in data units. The default: none.
+    fn report_params_at_scale(
+        &self,
+        parameters: &mut serde_json::Map<String, serde_json::Value>,
+        s: f64,
+    ) {
+        let _ = (parameters, s);
+    }
 }
 
 /// The result of [`fair`]: the faired points and the report.
@@ -137,6 +176,7 @@ pub struct Faired {
     pub tangents: Option<Vec<Vec2>>,
 }
 
+static BAND: Band = Band;
 static MST: Mst = Mst;
 static CALI: Cali = Cali;
 static HAN: Han = Han;
@@ -154,6 +194,7 @@ static KURAGANO: kuragano::Kuragano = kuragano::Kuragano;
 /// becomes the default.
 static REGISTRY: &[&dyn FairMethod] = &[
     &HAN,
+    &BAND,
     &MST,
     &CALI,
     &SALVI,
@@ -244,7 +285,8 @@ pub fn fair(name: &str, input: &PointSeq, options: &FairOptions) -> Result<Faire
 /// As [`fair`].
 pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) -> Result<Faired> {
     check_options(m, input.is_closed(), options)?;
-    let before = FairnessMetrics::of_seq(input)?;
+    let unit_scale = crate::geom::unit_scale(input.points());
+    let before = FairnessMetrics::of_seq(&in_unit(input, unit_scale)?)?;
     let start = Instant::now();
     let sigma = noise_sigma(input.points(), input.is_closed());
     let (resolved, source) = resolve_tolerance(m, options, sigma, input.bbox().diagonal())?;
@@ -263,12 +305,21 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
             ..Outcome::default()
         }
     } else {
-        m.run(input, options)?
+        let s = guard::method_scale(input);
+        let run_options = guard::per_move_options(options, &before);
+        if s == 1.0 {
+            m.run(input, &run_options)?
+        } else {
+            let (unit, unit_options) = guard::to_unit(m, input, &run_options, s)?;
+            let mut outcome = m.run(&unit, &unit_options)?;
+            guard::from_unit(m, &mut outcome, s)?;
+            outcome
+        }
     };
     finish(
         m,
-        input,
-        before,
+        (input, None),
+        (before, unit_scale),
         options,
         outcome,
         start,
@@ -367,17 +418,36 @@ pub fn fair_curve(name: &str, curve: &BSplineCurve, options: &FairOptions) -> Re
         });
     };
     let (input, outcome) = run?;
-    let before = FairnessMetrics::of_seq(&input)?;
-    finish(m, &input, before, options, outcome, start, (source, None))
+    let unit_scale = crate::geom::unit_scale(input.points());
+    let before = FairnessMetrics::of_seq(&in_unit(&input, unit_scale)?)?;
+    finish(
+        m,
+        (&input, Some(curve)),
+        (before, unit_scale),
+        options,
+        outcome,
+        start,
+        (source, None),
+    )
 }
 
-/// The common part of every report: displacements, metrics after, the tolerance verdict.
+/// `seq` divided by `s` (exact: `s` is a power of two).
+fn in_unit(seq: &PointSeq, s: f64) -> Result<PointSeq> {
+    if s == 1.0 {
+        return Ok(seq.clone());
+    }
+    seq.with_points(crate::geom::scale_points(seq.points(), 1.0 / s))
+}
+
+/// The common part of every report: the clean-curve guard, displacements, metrics after,
+/// the tolerance verdict. `before` is measured on the input divided by `unit_scale`, and
+/// `curve` is the input curve of [`fair_curve`].
 fn finish(
     m: &dyn FairMethod,
-    input: &PointSeq,
-    before: FairnessMetrics,
+    (input, curve): (&PointSeq, Option<&BSplineCurve>),
+    (before, unit_scale): (FairnessMetrics, f64),
     options: &FairOptions,
-    outcome: Outcome,
+    mut outcome: Outcome,
     start: Instant,
     (tolerance_source, noise_sigma): (Option<ToleranceSource>, Option<f64>),
 ) -> Result<Faired> {
@@ -389,8 +459,33 @@ fn finish(
             expected: input.len(),
         });
     }
-    let faired = input.with_points(outcome.points.clone())?;
-    let after = FairnessMetrics::of_seq(&faired)?;
+    let mut faired = input.with_points(outcome.points.clone())?;
+    let mut after = FairnessMetrics::of_seq(&in_unit(&faired, unit_scale)?)?;
+    if options.keep_clean
+        && m.keeps_clean()
+        && let Some(why) = guard::worse(&before, &after)
+    {
+        outcome = Outcome {
+            points: input.points().to_vec(),
+            status: FairStatus::NoChange,
+            iterations: outcome.iterations,
+            history: outcome.history,
+            parameters: outcome.parameters,
+            notes: {
+                let mut notes = outcome.notes;
+                notes.push(format!(
+                    "the result had {why} than the input, so the input is returned unchanged \
+                     (the clean-curve guard; keep_clean = false turns it off)"
+                ));
+                notes
+            },
+            curve: curve.cloned(),
+            ..Outcome::default()
+        };
+        faired = input.clone();
+        after = before.clone();
+    }
+    let (before, after) = (before.rescaled(unit_scale), after.rescaled(unit_scale));
     let end_changes = end_changes(input, &faired);
     let disp = displacement(input.points(), &outcome.points)?;
     let tolerance_met = options.tolerance.is_none_or(|d| disp.max <= d);
@@ -428,6 +523,7 @@ fn finish(
         elapsed_seconds: elapsed.as_secs_f64(),
         parameters: outcome.parameters,
         history: outcome.history,
+        solver: outcome.solver,
         notes,
     };
     Ok(Faired {

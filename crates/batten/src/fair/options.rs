@@ -130,6 +130,17 @@ pub struct FairOptions {
     ///
     /// Default value: empty.
     pub params: BTreeMap<String, String>,
+    /// The clean-curve guard: return the input unchanged (status `no_change`, with a note)
+    /// when a method's result has more inflections, more curvature vibrations (for an input
+    /// without inflections) or a higher variation energy than its input; and, on an input without inflections or vibrations,
+    /// the per-move check of the local methods (`han`, the Kjellander family,
+    /// `sapidis-farin`, `eck-hadenfeld`), which refuse single moves that would make the
+    /// curve worse near them. Methods exempt from it (`mst`, the csaps baseline) say so in
+    /// [`super::FairMethod::keeps_clean`]. `false` gives the methods as their papers state
+    /// them.
+    ///
+    /// Default value: `true`.
+    pub keep_clean: bool,
 }
 
 impl FairOptions {
@@ -141,6 +152,7 @@ impl FairOptions {
         fix_ends: EndFix::Free,
         max_iterations: None,
         params: BTreeMap::new(),
+        keep_clean: true,
     };
 
     /// Set the tolerance (largest allowed point displacement, data units).
@@ -172,6 +184,12 @@ impl FairOptions {
     /// Bound the number of iterations.
     pub fn with_max_iterations(mut self, n: usize) -> FairOptions {
         self.max_iterations = Some(n);
+        self
+    }
+
+    /// Turn the clean-curve guard on or off ([`FairOptions::keep_clean`]).
+    pub fn with_keep_clean(mut self, keep: bool) -> FairOptions {
+        self.keep_clean = keep;
         self
     }
 

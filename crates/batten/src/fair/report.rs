@@ -18,7 +18,8 @@ pub enum FairStatus {
     ToleranceLimited,
     /// The result exceeds the tolerance (the method could not meet it).
     ToleranceExceeded,
-    /// Nothing needed to change (the input is already fair by the method's criterion).
+    /// Nothing changed: the input is already fair by the method's criterion, or the
+    /// clean-curve guard returned the input because the result was worse (a note says so).
     NoChange,
 }
 
@@ -31,6 +32,18 @@ pub enum ToleranceSource {
     Given,
     /// Computed from the data as `k·σ̂` (`--tolerance auto`, or `band` without a tolerance).
     Auto,
+}
+
+/// What an optimisation-based method's solver did (`band`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct SolverInfo {
+    /// Interior-point iterations, over all passes.
+    pub iterations: usize,
+    /// The final surrogate duality gap, relative to the objective (or to 1).
+    pub duality_gap: f64,
+    /// Points whose displacement is within 0.01 % of the tolerance: where the band, not
+    /// the energy, decided.
+    pub points_on_band_edge: usize,
 }
 
 /// One point move of a local method.
@@ -119,6 +132,8 @@ pub struct FairReport {
     pub parameters: serde_json::Map<String, serde_json::Value>,
     /// Per-iteration trace.
     pub history: Vec<HistoryRow>,
+    /// The solver's figures, for methods that solve an optimisation problem (`band`).
+    pub solver: Option<SolverInfo>,
     /// Remarks for the user.
     pub notes: Vec<String>,
 }

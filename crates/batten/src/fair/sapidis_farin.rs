@@ -201,6 +201,9 @@ struct KnotState {
     held: usize,
     /// The number of points of a closed curve.
     period: Option<usize>,
+    /// Refuse moves that make the curve through the data points worse near them
+    /// ([`FairOptions::keep_clean`], the per-move clean-curve check).
+    keep_clean: bool,
 }
 
 impl KnotState {
@@ -369,6 +372,25 @@ impl LocalProblem for KnotState {
     fn max_displacement(&self) -> f64 {
         self.disp.max_value()
     }
+
+    fn worsens(&self, _j: usize, s: f64) -> bool {
+        if !self.keep_clean {
+            return false;
+        }
+        // The data points move by N_c(t_k)·s·d (the affected list of the plan).
+        let step = self.planned.1 * s;
+        let moved: Vec<(usize, Point)> = self
+            .affected
+            .iter()
+            .map(|&(k, n)| (k, self.q[k] + self.e[k] + step * n))
+            .collect();
+        super::clean::move_is_worse_by(
+            self.q.len(),
+            self.period.is_some(),
+            |k| self.q[k] + self.e[k],
+            &moved,
+        )
+    }
 }
 
 /// Padding of the wrapped form of a periodic cubic: period knot `τ_m` is knot index
@@ -437,6 +459,11 @@ pub(crate) fn interpolate_closed(points: &[Point]) -> Result<(BSplineCurve, Vec<
 /// (four spans) must be shorter than the period.
 pub const MIN_CLOSED_POINTS: usize = 6;
 
+/// Parameters in data units and their power of length: the B-spline's third-derivative
+/// jumps (on the averaging knots of the chord-length parameters, as the method measures them)
+/// scale as a length.
+const LENGTH_PARAMS: &[(&str, i32)] = &[("epsilon", 1), ("initial_max_jump", 1)];
+
 impl FairMethod for SapidisFarin {
     fn name(&self) -> &'static str {
         "sapidis-farin"
@@ -452,6 +479,22 @@ impl FairMethod for SapidisFarin {
 
     fn supports_closed(&self) -> bool {
         true
+    }
+
+    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
+        Ok(super::guard::length_params_at_scale(
+            options,
+            LENGTH_PARAMS,
+            s,
+        ))
+    }
+
+    fn report_params_at_scale(
+        &self,
+        parameters: &mut serde_json::Map<String, serde_json::Value>,
+        s: f64,
+    ) {
+        super::guard::report_length_params(parameters, LENGTH_PARAMS, s);
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {
@@ -483,6 +526,7 @@ impl FairMethod for SapidisFarin {
             affected: Vec::new(),
             held: options.fix_ends.held().max(2),
             period: closed.then_some(n),
+            keep_clean: options.keep_clean,
         };
         let candidates = if closed {
             n
@@ -504,6 +548,7 @@ impl FairMethod for SapidisFarin {
         );
         let points = state.output(&initial)?;
         Ok(Outcome {
+            solver: None,
             points,
             status: driven.status,
             iterations: driven.moves.len(),

@@ -1009,6 +1009,19 @@ static PARAMS: &[ParamSpec] = &[ParamSpec {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Mst;
 
+/// The smoothing parameter that gives the same curve when the data (points and chord-length
+/// parameters) are multiplied by `f`: the objective `p·Σ|y − f|² + (1 − p)·∫|f''|² dt`
+/// becomes `p·f²·Σ + (1 − p)/f·∫`, so the ratio `(1 − p)/p` is divided by `f³`. Exact in
+/// real arithmetic; the limits p → 1 (interpolation) and p → 0 (the line) are kept.
+pub fn p_at_scale(p: f64, f: f64) -> f64 {
+    if p <= 0.0 || p >= 1.0 {
+        return p;
+    }
+    // One factor at a time: f³ alone may overflow where the ratio does not.
+    let ratio = (1.0 - p) / p / f / f / f;
+    1.0 / (1.0 + ratio)
+}
+
 impl FairMethod for Mst {
     fn name(&self) -> &'static str {
         "mst"
@@ -1025,6 +1038,30 @@ impl FairMethod for Mst {
 
     fn supports_closed(&self) -> bool {
         true
+    }
+
+    fn keeps_clean(&self) -> bool {
+        // The csaps baseline: its result must stay equal to csaps'.
+        false
+    }
+
+    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
+        let mut o = options.clone();
+        if let Some(p) = param_p(options)? {
+            o.params
+                .insert("p".into(), format!("{:e}", p_at_scale(p, 1.0 / s)));
+        }
+        Ok(o)
+    }
+
+    fn report_params_at_scale(
+        &self,
+        parameters: &mut serde_json::Map<String, serde_json::Value>,
+        s: f64,
+    ) {
+        if let Some(p) = parameters.get("p").and_then(serde_json::Value::as_f64) {
+            parameters.insert("p".into(), json_f64(p_at_scale(p, s)));
+        }
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {

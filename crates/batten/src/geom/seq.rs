@@ -9,7 +9,8 @@ use crate::error::{Error, Result};
 /// - at least [`PointSeq::MIN_POINTS`] points;
 /// - every coordinate finite;
 /// - no two consecutive points equal (for a closed sequence this includes the last and the
-///   first: a closed curve is given *without* repeating its first point at the end).
+///   first: a closed curve is given *without* repeating its first point at the end), nor
+///   closer than [`NEAR_DUPLICATE_REL`] of the larger side of the bounding box.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PointSeq {
     points: Vec<Point>,
@@ -23,8 +24,8 @@ impl PointSeq {
     /// Validate and wrap a point list.
     ///
     /// # Errors
-    /// [`Error::TooFewPoints`], [`Error::NonFinite`] or [`Error::DuplicatePoint`] naming the
-    /// index of the first offending point.
+    /// [`Error::TooFewPoints`], [`Error::NonFinite`], [`Error::DuplicatePoint`] or
+    /// [`Error::NearDuplicate`] naming the index of the first offending point.
     pub fn new(points: Vec<Point>, closed: bool) -> Result<PointSeq> {
         validate_points(&points, closed, Self::MIN_POINTS)?;
         Ok(PointSeq { points, closed })
@@ -98,7 +99,8 @@ impl PointSeq {
 /// Check that `points` has at least `min` entries, all finite, with no zero-length chord.
 ///
 /// # Errors
-/// [`Error::TooFewPoints`], [`Error::NonFinite`] or [`Error::DuplicatePoint`].
+/// [`Error::TooFewPoints`], [`Error::NonFinite`], [`Error::DuplicatePoint`] or
+/// [`Error::NearDuplicate`].
 pub(crate) fn validate_points(points: &[Point], closed: bool, min: usize) -> Result<()> {
     if points.len() < min {
         return Err(Error::TooFewPoints {
@@ -117,12 +119,92 @@ pub(crate) fn validate_points(points: &[Point], closed: bool, min: usize) -> Res
             index: points.len() - 1,
         });
     }
+    near_duplicates(points, closed)
+}
+
+/// Consecutive points closer than this fraction of the larger side of the bounding box are
+/// refused as near-duplicates ([`Error::NearDuplicate`]). Coordinates of magnitude R carry a
+/// rounding of about 10⁻¹⁶·R, so a chord of 10⁻¹² of the curve's size has its length and
+/// direction known to no better than 10⁻⁴: every chord-length spline through it (the analysis
+/// curve, most methods) is then shaped by rounding, and below about 10⁻¹⁴ its system is
+/// singular. The densest scan batten is meant for (10⁷ points) has chords near 10⁻⁷ of the
+/// size.
+pub const NEAR_DUPLICATE_REL: f64 = 1e-12;
+
+/// [`Error::NearDuplicate`] for the first chord shorter than [`NEAR_DUPLICATE_REL`] of the
+/// larger side of the bounding box. Halved coordinates, so that nothing overflows near
+/// `f64::MAX`.
+fn near_duplicates(points: &[Point], closed: bool) -> Result<()> {
+    let Some(b) = BBox::from_points(points) else {
+        return Ok(());
+    };
+    let half = |v: f64| 0.5 * v;
+    let size = (half(b.max.x) - half(b.min.x)).max(half(b.max.y) - half(b.min.y));
+    let limit = NEAR_DUPLICATE_REL * size;
+    let n = points.len();
+    let chords = if closed { n } else { n - 1 };
+    for i in 0..chords {
+        let (a, c) = (points[i], points[(i + 1) % n]);
+        let d = (half(c.x) - half(a.x)).hypot(half(c.y) - half(a.y));
+        if d < limit {
+            return Err(Error::NearDuplicate {
+                index: (i + 1) % n,
+                previous: i,
+                relative: d / size,
+            });
+        }
+    }
     Ok(())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn near_duplicates_are_refused_at_any_scale() {
+        for scale in [1e-300, 1.0, 1e300, f64::MAX / 16.0] {
+            let pts = |gap: f64| -> Vec<Point> {
+                [
+                    (0.0, 0.0),
+                    (1.0, 0.5),
+                    (1.0 + gap, 0.5),
+                    (2.0, 0.0),
+                    (3.0, 1.0),
+                ]
+                .iter()
+                .map(|&(x, y)| Point::new(x * scale, y * scale))
+                .collect()
+            };
+            // Issue #14: two points 1e-15 apart made the analysis spline singular.
+            match PointSeq::open(pts(1e-15)) {
+                Err(Error::NearDuplicate {
+                    index: 2,
+                    previous: 1,
+                    relative,
+                }) => assert!(relative < NEAR_DUPLICATE_REL, "{relative}"),
+                other => panic!("at scale {scale}: {other:?}"),
+            }
+            assert!(PointSeq::open(pts(1e-9)).is_ok(), "at scale {scale}");
+        }
+        // The closing chord of a closed curve.
+        let sq = vec![
+            Point::new(0.0, 0.0),
+            Point::new(1.0, 0.0),
+            Point::new(1.0, 1.0),
+            Point::new(0.0, 1.0),
+            Point::new(1e-14, 0.0),
+        ];
+        assert!(PointSeq::open(sq.clone()).is_ok());
+        assert!(matches!(
+            PointSeq::closed(sq),
+            Err(Error::NearDuplicate {
+                index: 0,
+                previous: 4,
+                ..
+            })
+        ));
+    }
 
     fn square() -> Vec<Point> {
         vec![

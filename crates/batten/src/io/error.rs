@@ -32,7 +32,10 @@ pub enum IoError {
         source: std::io::Error,
     },
     /// The file name's extension names no supported format.
-    #[error("{}: unknown file format (use a .csv, .txt or .json file name)", path.display())]
+    #[error(
+        "{}: unknown file format (use a .csv, .txt, .json, .dxf, .igs/.iges or .svg file name)",
+        path.display()
+    )]
     UnknownFormat {
         /// The file.
         path: PathBuf,
@@ -99,13 +102,13 @@ pub enum IoError {
         value: f64,
     },
     /// A point nearly duplicates its neighbour: closer than
-    /// [`super::NEAR_DUPLICATE_RELATIVE`] times the larger side of the bounding box.
+    /// [`crate::geom::NEAR_DUPLICATE_REL`] times the larger side of the bounding box (the
+    /// library's [`crate::Error::NearDuplicate`], with lines).
     #[error(
-        "{}:{line}: point nearly duplicates the one on line {other} ({} apart, under {}, \
-         1e-12 of the curve's size); remove one of them",
+        "{}:{line}: point nearly duplicates the one on line {other} ({relative:.1e} of the \
+         curve's size apart, under {limit:e}); remove one of them",
         path.display(),
-        super::format_f64(*distance),
-        super::format_f64(*threshold)
+        limit = crate::geom::NEAR_DUPLICATE_REL
     )]
     NearDuplicate {
         /// The file.
@@ -114,10 +117,8 @@ pub enum IoError {
         line: usize,
         /// The 1-based line of the point it nearly repeats.
         other: usize,
-        /// Their distance.
-        distance: f64,
-        /// The distance below which points are refused.
-        threshold: f64,
+        /// Their distance over the larger side of the bounding box.
+        relative: f64,
     },
     /// Fewer points than batten needs ([`crate::PointSeq::MIN_POINTS`]).
     #[error("{}: {got} point{}, at least {needed} needed", path.display(), plural(*got))]
@@ -176,6 +177,18 @@ pub enum IoError {
     JsonContent {
         /// The file.
         path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// A DXF, IGES or SVG file is malformed, holds something batten does not take (a 3-D
+    /// curve, an arc, a transform), or does not say which of its curves to take. `message`
+    /// names the entity (DXF handle, IGES directory entry, SVG element) where there is one.
+    #[error("{}{at}: {message}", path.display())]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// Where in the file, as far as the format can tell.
+        at: Location,
         /// What is wrong.
         message: String,
     },
@@ -243,4 +256,43 @@ pub enum IoError {
 /// The plural ending of a count: "1 point", "2 points".
 fn plural(n: usize) -> &'static str {
     if n == 1 { "" } else { "s" }
+}
+
+/// A place in a file, for [`IoError::Format`]: displayed as nothing, `:LINE` or
+/// `:LINE:COLUMN` after the file name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Location {
+    /// The file as a whole (the message names the entity).
+    File,
+    /// A 1-based line.
+    Line(usize),
+    /// A 1-based line and column.
+    LineColumn(usize, usize),
+}
+
+impl std::fmt::Display for Location {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Location::File => Ok(()),
+            Location::Line(l) => write!(f, ":{l}"),
+            Location::LineColumn(l, c) => write!(f, ":{l}:{c}"),
+        }
+    }
+}
+
+/// A message from another crate on one line: control characters (a newline it quotes from
+/// the file) written as escapes.
+pub(crate) fn one_line(message: &str) -> String {
+    message
+        .chars()
+        .flat_map(|c| {
+            let escaped: Vec<char> = if c.is_control() {
+                c.escape_default().collect()
+            } else {
+                vec![c]
+            };
+            escaped
+        })
+        .collect()
 }

@@ -63,7 +63,7 @@ enum Shape {
 }
 
 /// Convert a serde_json error into one that names the file, line and column.
-fn json_error(path: &Path, e: &serde_json::Error) -> IoError {
+pub(super) fn json_error(path: &Path, e: &serde_json::Error) -> IoError {
     let full = e.to_string();
     if e.line() == 0 {
         return IoError::JsonContent {
@@ -107,7 +107,7 @@ fn shape(text: &str, path: &Path) -> Result<Shape, IoError> {
     })
 }
 
-fn utf8<'a>(bytes: &'a [u8], path: &Path) -> Result<&'a str, IoError> {
+pub(super) fn utf8<'a>(bytes: &'a [u8], path: &Path) -> Result<&'a str, IoError> {
     std::str::from_utf8(bytes).map_err(|e| IoError::NotUtf8 {
         path: path.to_path_buf(),
         line: 1 + bytes[..e.valid_up_to()]

@@ -1,12 +1,12 @@
-//! What a point file may hold beyond "finite numbers": a bound on coordinate magnitudes, and
-//! no two consecutive points so close that the curve through them is numerically singular.
-//! Both are refused at input with the file and line, rather than failing later inside a
-//! method with no line to name.
+//! What a point file may hold beyond "finite numbers": a bound on coordinate magnitudes,
+//! refused at input with the file and line. (Near-duplicate points are refused by
+//! [`crate::PointSeq`] itself, [`crate::geom::NEAR_DUPLICATE_REL`]; `io::validate` names
+//! their lines.)
 
 use std::path::Path;
 
 use super::IoError;
-use crate::geom::{BBox, Point};
+use crate::geom::Point;
 
 /// Largest coordinate magnitude accepted, `|x|, |y| ≤ 1e300`.
 ///
@@ -17,17 +17,6 @@ use crate::geom::{BBox, Point};
 /// refused here with its line instead. Small magnitudes are not bounded: tiny coordinates
 /// are a matter of scale.
 pub const MAX_COORDINATE: f64 = 1e300;
-
-/// Two consecutive points closer than this fraction of the larger side of the bounding box
-/// are refused as near-duplicates.
-///
-/// Coordinates of magnitude `R` carry a rounding of about `1e-16 R`, so a chord of `1e-12` of
-/// the curve's size has its length and direction known to no better than `1e-4`: every
-/// chord-length spline through it (the analysis curve, most methods) is then shaped by
-/// rounding, and near `1e-15` its linear system is singular (issue #14: two points `1e-15`
-/// apart gave "zero pivot in band LU"). The densest scans batten is meant for (10⁷ points)
-/// have chords near `1e-7` of the size.
-pub const NEAR_DUPLICATE_RELATIVE: f64 = 1e-12;
 
 /// Refuse a coordinate beyond [`MAX_COORDINATE`], naming its line.
 pub(crate) fn check_magnitudes(
@@ -47,40 +36,6 @@ pub(crate) fn check_magnitudes(
             })
         }
     }
-}
-
-/// Refuse two consecutive points (and, on a closed curve, the last and the first) closer
-/// than [`NEAR_DUPLICATE_RELATIVE`] times the larger side of the bounding box. Exact
-/// duplicates are left to [`crate::PointSeq::new`], which names them as such.
-pub(crate) fn check_near_duplicates(
-    path: &Path,
-    points: &[Point],
-    lines: &[usize],
-    closed: bool,
-) -> Result<(), IoError> {
-    let Some(bbox) = BBox::from_points(points) else {
-        return Ok(());
-    };
-    let size = (bbox.max.x - bbox.min.x).max(bbox.max.y - bbox.min.y);
-    let threshold = NEAR_DUPLICATE_RELATIVE * size;
-    let n = points.len();
-    let pairs = (1..n)
-        .map(|i| (i - 1, i))
-        .chain((closed && n > 2).then_some((0, n - 1)));
-    for (a, b) in pairs {
-        let d = points[a].distance(points[b]);
-        if d > 0.0 && d < threshold {
-            let line = |i: usize| lines.get(i).copied().unwrap_or(1);
-            return Err(IoError::NearDuplicate {
-                path: path.to_path_buf(),
-                line: line(b),
-                other: line(a),
-                distance: d,
-                threshold,
-            });
-        }
-    }
-    Ok(())
 }
 
 #[cfg(test)]
@@ -120,8 +75,8 @@ mod tests {
         // The issue's repro: two points 1e-15 apart on a curve of extent ~3.
         assert_eq!(
             msg("0,0\n1,1\n1.000000000000001,1\n2,0\n3,1\n", false),
-            "d.csv:3: point nearly duplicates the one on line 2 (1.1102230246251565e-15 apart, \
-             under 3e-12, 1e-12 of the curve's size); remove one of them"
+            "d.csv:3: point nearly duplicates the one on line 2 (3.7e-16 of the curve's size \
+             apart, under 1e-12); remove one of them"
         );
         // The same spacing is fine at a scale where it is not small: the test is relative.
         let s = |v: f64| format!("{v}");
@@ -137,8 +92,8 @@ mod tests {
         // On a closed curve, the last point against the first.
         assert_eq!(
             msg("0,0\n1,0\n1,1\n0,1\n0,1e-13\n", true),
-            "d.csv:5: point nearly duplicates the one on line 1 (1e-13 apart, under 1e-12, \
-             1e-12 of the curve's size); remove one of them"
+            "d.csv:5: point nearly duplicates the one on line 1 (1.0e-13 of the curve's size \
+             apart, under 1e-12); remove one of them"
         );
         assert_eq!(msg("0,0\n1,0\n1,1\n0,1\n0,1e-13\n", false), "");
         // Exact duplicates keep their own message.
@@ -153,6 +108,6 @@ mod tests {
         // The largest accepted box has a finite diagonal: differences never overflow.
         let d = Point::new(MAX_COORDINATE, MAX_COORDINATE) - Point::new(-MAX_COORDINATE, 0.0);
         assert!(d.length().is_finite());
-        const { assert!(NEAR_DUPLICATE_RELATIVE > 1e3 * f64::EPSILON) };
+        const { assert!(crate::geom::NEAR_DUPLICATE_REL > 1e3 * f64::EPSILON) };
     }
 }

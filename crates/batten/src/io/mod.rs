@@ -1,7 +1,8 @@
-//! Reading and writing point lists and curves (CSV/whitespace text and JSON).
+//! Reading and writing point lists and curves: CSV/whitespace text, JSON, DXF, IGES, SVG.
 //!
 //! The format follows the file name's extension ([`Format::from_path`]): `.csv` and `.txt`
-//! are text (one `x,y` per line, see [Text format](#text-format)), `.json` is JSON.
+//! are text (one `x,y` per line, see [Text format](#text-format)), `.json` is JSON, `.dxf`,
+//! `.igs`/`.iges` and `.svg` the CAD formats (see [Other formats](#other-formats)).
 //!
 //! - [`read_points`] reads a point list and validates it into a [`PointSeq`], keeping the
 //!   1-based line of every point so that every error names the file and the line:
@@ -13,7 +14,26 @@
 //!   any work whether an output can be created; [`remove_temporaries`] cleans up on a signal.
 //! - [`ensure_distinct`] refuses an output path that is the input file.
 //!
+//! - [`parse_input`] / [`read_input`] read any format from bytes (standard input) or a file,
+//!   picking one curve of a file that holds several ([`Pick`]), into points or a B-spline
+//!   ([`Source`]) and where it sat ([`Origin`]: z, layer, name), so that
+//!   [`format_points`] and [`format_curve`] can write the result back alike.
+//! - [`DxfDrawing`] keeps a whole DXF drawing to write it back with several curves replaced.
+//!
 //! Nothing here prints; every failure is an [`IoError`].
+//!
+//! # Other formats
+//!
+//! | format | read | written by [`format_points`] | written by [`format_curve`] |
+//! |---|---|---|---|
+//! | DXF (`dxf` crate) | `LWPOLYLINE`, `POLYLINE`, `SPLINE` (control points: a B-spline; fit points only: points) | `LWPOLYLINE` | `SPLINE` |
+//! | IGES (5.3, fixed form) | entity 126 (B-spline), 106 (copious data) | entity 106 | entity 126 |
+//! | SVG (`roxmltree`) | `<path>` (lines: points; Béziers: a cubic B-spline), `<polyline>`, `<polygon>` | a path of the C² cubic through the points | a path of Bézier segments |
+//!
+//! The curve must be planar (constant z; the z is kept in [`Origin`] and written back) and
+//! untransformed; each module's documentation (`io/dxf.rs`, `io/iges.rs`, `io/svg/`) says
+//! exactly what it takes and refuses. IGES, SVG, text and JSON read back bit for bit; DXF
+//! within the 12 decimal places the `dxf` crate writes.
 //!
 //! # Text format
 //!
@@ -48,17 +68,23 @@
 //! ```
 
 mod atomic;
+mod dxf;
 mod error;
+mod iges;
 mod json;
 mod limits;
+mod surface;
+mod svg;
 mod text;
 
 use std::fs;
 use std::path::{Path, PathBuf};
 
 pub use atomic::{check_writable, remove_temporaries, write_atomic, write_atomic_set};
-pub use error::IoError;
-pub use limits::{MAX_COORDINATE, NEAR_DUPLICATE_RELATIVE};
+pub use dxf::{DxfCurve, DxfDrawing, DxfGeometry};
+pub use error::{IoError, Location};
+pub use limits::MAX_COORDINATE;
+pub use surface::{format_surface, parse_surface, read_surface_json, write_surface_json};
 pub use text::format_f64;
 
 use crate::error::Error;
@@ -73,6 +99,12 @@ pub enum Format {
     Text,
     /// `.json`: a point list object or a B-spline object.
     Json,
+    /// `.dxf`: LWPOLYLINE, POLYLINE or SPLINE entities (see [Other formats](#other-formats)).
+    Dxf,
+    /// `.igs` or `.iges`: entity 126 (rational B-spline curve) or 106 (copious data).
+    Iges,
+    /// `.svg`: a `<path>`, `<polyline>` or `<polygon>`.
+    Svg,
 }
 
 impl Format {
@@ -86,12 +118,24 @@ impl Format {
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
-        match ext.as_deref() {
-            Some("csv" | "txt") => Ok(Format::Text),
-            Some("json") => Ok(Format::Json),
-            _ => Err(IoError::UnknownFormat {
+        match ext.as_deref().and_then(Format::from_name) {
+            Some(f) => Ok(f),
+            None => Err(IoError::UnknownFormat {
                 path: path.to_path_buf(),
             }),
+        }
+    }
+
+    /// The format of a name as given to `--format` or as an extension (lower case):
+    /// `csv`/`txt`, `json`, `dxf`, `igs`/`iges`, `svg`.
+    pub fn from_name(name: &str) -> Option<Format> {
+        match name {
+            "csv" | "txt" => Some(Format::Text),
+            "json" => Some(Format::Json),
+            "dxf" => Some(Format::Dxf),
+            "igs" | "iges" => Some(Format::Iges),
+            "svg" => Some(Format::Svg),
+            _ => None,
         }
     }
 }
@@ -153,7 +197,7 @@ pub fn read_points(path: &Path, options: &ReadOptions) -> Result<PointData, IoEr
 /// [`IoError::CurveNotPoints`]; then, for the whole list, [`IoError::Empty`],
 /// [`IoError::TooLarge`] (beyond [`MAX_COORDINATE`]), [`IoError::TooFewPoints`],
 /// [`IoError::DuplicatePoint`], [`IoError::RepeatsFirst`], [`IoError::NearDuplicate`]
-/// (closer than [`NEAR_DUPLICATE_RELATIVE`] of the bounding-box diagonal),
+/// (closer than [`crate::geom::NEAR_DUPLICATE_REL`] of the bounding box's larger side),
 /// [`IoError::TangentCount`].
 pub fn parse_points(
     bytes: &[u8],
@@ -169,6 +213,14 @@ pub fn parse_points(
         Format::Json => {
             let j = json::parse_points(bytes, path)?;
             (j.points, j.lines, j.closed, j.tangents, j.tangent_lines)
+        }
+        Format::Dxf | Format::Iges | Format::Svg => {
+            return match parse_input(bytes, format, path, options, &Pick::default())?.source {
+                Source::Points(d) => Ok(d),
+                Source::Curve(_) => Err(IoError::CurveNotPoints {
+                    path: path.to_path_buf(),
+                }),
+            };
         }
     };
     let closed = closed || options.closed;
@@ -209,7 +261,6 @@ fn validate(
     }
     let line = |i: usize| lines.get(i).copied().unwrap_or(1);
     limits::check_magnitudes(path, &points, lines)?;
-    limits::check_near_duplicates(path, &points, lines, closed)?;
     // What tells a repeated neighbour from a closed curve's repeated first point, noted before
     // the points move into the sequence (rather than validating a copy: 16 MB at 10⁶ points).
     let n = points.len();
@@ -238,6 +289,16 @@ fn validate(
             path: path.to_path_buf(),
             line: line(index),
             first: line(0),
+        }),
+        Err(Error::NearDuplicate {
+            index,
+            previous,
+            relative,
+        }) => Err(IoError::NearDuplicate {
+            path: path.to_path_buf(),
+            line: line(index),
+            other: line(previous),
+            relative,
         }),
         Err(source) => Err(IoError::Invalid {
             path: path.to_path_buf(),
@@ -293,7 +354,7 @@ pub fn write_points(
     tangents: Option<&[Vec2]>,
 ) -> Result<(), IoError> {
     let contents = encode_points(path, points, closed, tangents)?;
-    write_atomic(path, contents.as_bytes())
+    write_atomic(path, &contents)
 }
 
 /// The text [`write_points`] would write to `path` (format by extension), to write it later
@@ -306,8 +367,196 @@ pub fn encode_points(
     points: &[Point],
     closed: bool,
     tangents: Option<&[Vec2]>,
-) -> Result<String, IoError> {
+) -> Result<Vec<u8>, IoError> {
     let format = Format::from_path(path)?;
+    format_points(format, path, points, closed, tangents, &Origin::default())
+}
+
+/// Which curve to take from a file that can hold several (DXF, IGES, SVG), and how.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct Pick {
+    /// DXF: the entity's handle (hexadecimal, any case); IGES: the directory entry's
+    /// sequence number (`D` line of its first record).
+    ///
+    /// Default value: `None` (the only curve of the file).
+    pub entity: Option<String>,
+    /// DXF: the layer name; IGES: the level number.
+    ///
+    /// Default value: `None`.
+    pub layer: Option<String>,
+    /// SVG: the `id` of the element.
+    ///
+    /// Default value: `None`.
+    pub id: Option<String>,
+    /// SVG: take N points per segment of a path instead of its B-spline.
+    ///
+    /// Default value: `None`.
+    pub sample: Option<usize>,
+}
+
+impl Pick {
+    /// Pick by DXF handle or IGES directory entry.
+    pub fn with_entity(mut self, entity: Option<String>) -> Pick {
+        self.entity = entity;
+        self
+    }
+    /// Pick by DXF layer or IGES level.
+    pub fn with_layer(mut self, layer: Option<String>) -> Pick {
+        self.layer = layer;
+        self
+    }
+    /// Pick an SVG element by id.
+    pub fn with_id(mut self, id: Option<String>) -> Pick {
+        self.id = id;
+        self
+    }
+    /// Sample SVG paths with N points per segment.
+    pub fn with_sample(mut self, sample: Option<usize>) -> Pick {
+        self.sample = sample;
+        self
+    }
+}
+
+/// Where a curve sat in its file, so that it can be written back alike.
+#[derive(Clone, Debug, Default, PartialEq)]
+#[non_exhaustive]
+pub struct Origin {
+    /// The constant z of a planar curve from a 3-D format (DXF, IGES); written back.
+    pub z: f64,
+    /// The DXF layer (or IGES level) it was on.
+    pub layer: Option<String>,
+    /// Its name: DXF handle, IGES directory entry, SVG id.
+    pub name: Option<String>,
+}
+
+/// What an input file holds.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Source {
+    /// A validated point list.
+    Points(PointData),
+    /// A B-spline curve.
+    Curve(BSplineCurve),
+}
+
+/// A curve read from a file and where it sat.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Input {
+    /// The points or the curve.
+    pub source: Source,
+    /// Where it came from.
+    pub origin: Origin,
+}
+
+/// What a format reader hands back before validation.
+#[derive(Debug)]
+pub(crate) enum Raw {
+    /// Points with the 1-based line of each, closed or not.
+    Points {
+        points: Vec<Point>,
+        lines: Vec<usize>,
+        closed: bool,
+    },
+    /// A B-spline.
+    Curve(BSplineCurve),
+}
+
+/// Parse any input format held in memory (a file's bytes, or standard input); `path` names
+/// it in messages. Points are validated as by [`parse_points`]; a B-spline is returned as
+/// it is.
+///
+/// # Errors
+/// Everything [`parse_points`] reports, and [`IoError::Format`] for a malformed DXF, IGES or
+/// SVG file, a 3-D curve (z not constant), or a choice the file leaves open.
+pub fn parse_input(
+    bytes: &[u8],
+    format: Format,
+    path: &Path,
+    options: &ReadOptions,
+    pick: &Pick,
+) -> Result<Input, IoError> {
+    let (raw, origin) = match format {
+        Format::Text => {
+            let d = parse_points(bytes, format, path, options)?;
+            return Ok(Input {
+                source: Source::Points(d),
+                origin: Origin::default(),
+            });
+        }
+        Format::Json => {
+            let source = match parse_points(bytes, format, path, options) {
+                Ok(d) => Source::Points(d),
+                Err(IoError::CurveNotPoints { .. }) => {
+                    Source::Curve(json::parse_curve(bytes, path)?)
+                }
+                Err(e) => return Err(e),
+            };
+            return Ok(Input {
+                source,
+                origin: Origin::default(),
+            });
+        }
+        Format::Dxf => dxf::parse(bytes, path, pick)?,
+        Format::Iges => iges::parse(bytes, path, pick)?,
+        Format::Svg => svg::parse(bytes, path, pick)?,
+    };
+    Ok(Input {
+        source: validated(raw, path, options)?,
+        origin,
+    })
+}
+
+/// Validate what a format reader gave: points as [`parse_points`] does, a B-spline as it is.
+fn validated(raw: Raw, path: &Path, options: &ReadOptions) -> Result<Source, IoError> {
+    Ok(match raw {
+        Raw::Points {
+            points,
+            lines,
+            closed,
+        } => Source::Points(PointData {
+            seq: validate(path, points, &lines, closed || options.closed)?,
+            tangents: None,
+            lines,
+        }),
+        Raw::Curve(c) => Source::Curve(c),
+    })
+}
+
+/// Read any input file (format by extension, or `format` when given).
+///
+/// # Errors
+/// [`IoError::Read`], [`IoError::UnknownFormat`], and everything [`parse_input`] reports.
+pub fn read_input(
+    path: &Path,
+    format: Option<Format>,
+    options: &ReadOptions,
+    pick: &Pick,
+) -> Result<Input, IoError> {
+    let format = match format {
+        Some(f) => f,
+        None => Format::from_path(path)?,
+    };
+    let bytes = read_bytes(path)?;
+    parse_input(&bytes, format, path, options, pick)
+}
+
+/// The bytes of a point list in `format`: text, JSON, a DXF LWPOLYLINE, an IGES copious-data
+/// entity (106, form 11 or 63 when closed), or an SVG path of the C² cubic through the
+/// points (chord-length parameters, not-a-knot ends, or periodic when closed). `origin`
+/// gives the z, layer and name for the formats that hold them; `path` names the output in
+/// messages.
+///
+/// # Errors
+/// [`IoError::NonFiniteOutput`]; [`IoError::Format`] when the cubic through the points
+/// cannot be built (SVG).
+pub fn format_points(
+    format: Format,
+    path: &Path,
+    points: &[Point],
+    closed: bool,
+    tangents: Option<&[Vec2]>,
+    origin: &Origin,
+) -> Result<Vec<u8>, IoError> {
     let bad_point = points.iter().position(|p| !p.is_finite());
     let bad_tangent = tangents.and_then(|t| t.iter().position(|v| !v.is_finite()));
     if let Some(index) = bad_point.or(bad_tangent) {
@@ -317,8 +566,70 @@ pub fn encode_points(
         });
     }
     Ok(match format {
-        Format::Text => text::format(points),
-        Format::Json => json::format(points, closed, tangents),
+        Format::Text => text::format(points).into_bytes(),
+        Format::Json => json::format(points, closed, tangents).into_bytes(),
+        Format::Dxf => dxf::format_points(points, closed, origin, path)?,
+        Format::Iges => iges::format_points(points, closed, origin).into_bytes(),
+        Format::Svg => {
+            let curve = cubic_through(points, closed).map_err(|e| IoError::Format {
+                path: path.to_path_buf(),
+                at: Location::File,
+                message: format!("cannot build the cubic through the points: {e}"),
+            })?;
+            svg::format_curve(&curve, closed, origin, path)?.into_bytes()
+        }
+    })
+}
+
+/// The C² cubic through the points as a B-spline (the analysis curve of `crate::analysis`).
+fn cubic_through(points: &[Point], closed: bool) -> crate::Result<BSplineCurve> {
+    use crate::spline::{EndCondition, ParametricCubic, Parametrization};
+    let c = if closed {
+        ParametricCubic::closed(points, Parametrization::ChordLength)?
+    } else {
+        ParametricCubic::interpolate(points, Parametrization::ChordLength, EndCondition::NotAKnot)?
+    };
+    BSplineCurve::from_parametric_cubic(&c)
+}
+
+/// Whether [`format_curve`] can write `curve` as SVG (non-rational, degree 1 to 3, clamped).
+pub fn svg_can_hold(curve: &BSplineCurve) -> bool {
+    svg::bezier_segments(curve).is_ok()
+}
+
+/// The bytes of a B-spline curve in `format`: JSON as [`BSplineCurve`] serialises, a DXF
+/// SPLINE, an IGES entity 126, or an SVG path of Bézier segments.
+///
+/// # Errors
+/// [`IoError::Format`] for text (which holds no curve), a curve SVG cannot hold, or one
+/// that does not serialise.
+pub fn format_curve(
+    format: Format,
+    path: &Path,
+    curve: &BSplineCurve,
+    closed: bool,
+    origin: &Origin,
+) -> Result<Vec<u8>, IoError> {
+    let fail = |message: String| IoError::Format {
+        path: path.to_path_buf(),
+        at: Location::File,
+        message,
+    };
+    Ok(match format {
+        Format::Text => {
+            return Err(fail(
+                "a text file holds points, not a B-spline: use .json, .dxf, .igs or .svg".into(),
+            ));
+        }
+        Format::Json => {
+            let mut json = serde_json::to_string_pretty(curve)
+                .map_err(|e| fail(format!("cannot encode the curve: {e}")))?;
+            json.push('\n');
+            json.into_bytes()
+        }
+        Format::Dxf => dxf::format_curve(curve, closed, origin, path)?,
+        Format::Iges => iges::format_curve(curve, closed, origin).into_bytes(),
+        Format::Svg => svg::format_curve(curve, closed, origin, path)?.into_bytes(),
     })
 }
 
@@ -412,7 +723,9 @@ mod tests {
             let e = Format::from_path(Path::new(bad)).unwrap_err().to_string();
             assert_eq!(
                 e,
-                format!("{bad}: unknown file format (use a .csv, .txt or .json file name)")
+                format!(
+                    "{bad}: unknown file format (use a .csv, .txt, .json, .dxf, .igs/.iges or .svg file name)"
+                )
             );
         }
     }
@@ -530,6 +843,7 @@ mod tests {
         assert!(text.starts_with("x,y\n-0,1e-300\n1e300,5e-324\n"), "{text}");
         // Closed, the last point must not nearly repeat the first (relative to the extent).
         let path = dir.join("closed.json");
+        // Closed, these points would be refused: the closing chord, π, is 10⁻³⁰⁸ of the size.
         let square =
             [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)].map(|(x, y)| Point::new(x, y));
         write_points(&path, &square, true, None).unwrap();

@@ -16,6 +16,7 @@ mod lambda_operator;
 mod parametric;
 pub mod quintic;
 
+pub(crate) use bspline::basis_derivs;
 pub use bspline::{BSplineCurve, MAX_ORDER};
 pub use bspline_ops::{DEVIATION_SAMPLES_PER_SPAN, KnotRef, KnotRemoval, RemovalRule};
 pub use function::{CubicSplineFn, FnEndCondition};

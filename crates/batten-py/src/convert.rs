@@ -1,0 +1,102 @@
+//! numpy arrays in, numpy arrays and plain Python values out.
+
+use batten::Point;
+use numpy::ndarray::Array2;
+use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods as _, PyUntypedArrayMethods as _};
+use pyo3::prelude::*;
+
+use crate::errors;
+
+/// `obj` as a float64 numpy array: itself when it already is one, else `numpy.asarray(obj,
+/// "float64")` (lists, integer arrays, pandas columns).
+fn float_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    if let Ok(a) = obj.cast::<PyArrayDyn<f64>>() {
+        return Ok(a.clone());
+    }
+    let py = obj.py();
+    let converted = py
+        .import("numpy")?
+        .getattr("asarray")?
+        .call1((obj, "float64"))
+        .map_err(|e| errors::value(format!("{what}: not an array of numbers: {}", e.value(py))))?;
+    Ok(converted.cast_into::<PyArrayDyn<f64>>()?)
+}
+
+/// Points from an `(n, 2)` array-like of x, y. An `(n, 3)` array is refused: the library
+/// fairs planar curves only.
+pub fn points(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<Point>> {
+    let array = float_array(obj, what)?;
+    let shape = array.shape().to_vec();
+    match shape.as_slice() {
+        [_, 2] => {}
+        [_, 3] => {
+            return Err(errors::value(format!(
+                "{what}: 3-D curves (an (n, 3) array) are not supported yet; give an (n, 2) array of x, y"
+            )));
+        }
+        _ => {
+            return Err(errors::value(format!(
+                "{what}: expected an (n, 2) array of x, y, got shape {}",
+                shape_text(&shape)
+            )));
+        }
+    }
+    let view = array.try_readonly()?;
+    let view = view.as_array();
+    Ok(view
+        .outer_iter()
+        .map(|row| Point::new(row[0], row[1]))
+        .collect())
+}
+
+/// A 1-D array-like of numbers.
+pub fn vector(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+    let array = float_array(obj, what)?;
+    if array.ndim() != 1 {
+        return Err(errors::value(format!(
+            "{what}: expected a 1-D array, got shape {}",
+            shape_text(array.shape())
+        )));
+    }
+    let view = array.try_readonly()?;
+    Ok(view.as_array().iter().copied().collect())
+}
+
+/// `(3, 2)` as Python writes a shape.
+fn shape_text(shape: &[usize]) -> String {
+    match shape {
+        [n] => format!("({n},)"),
+        _ => format!(
+            "({})",
+            shape
+                .iter()
+                .map(usize::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+/// An `(n, 2)` array of the points' x, y.
+pub fn points_array<'py>(py: Python<'py>, points: &[Point]) -> Bound<'py, PyArray2<f64>> {
+    let flat: Vec<f64> = points.iter().flat_map(|p| [p.x, p.y]).collect();
+    // `flat` holds exactly 2·n values, so the shape always fits.
+    match Array2::from_shape_vec((points.len(), 2), flat) {
+        Ok(a) => PyArray2::from_owned_array(py, a),
+        Err(_) => PyArray2::zeros(py, [0, 2], false),
+    }
+}
+
+/// A 1-D array.
+pub fn vector_array<'py>(py: Python<'py>, values: &[f64]) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_slice(py, values)
+}
+
+/// A serialisable value as Python: `json.loads` of its JSON text, so that a report is exactly
+/// what `json.load` gives for the CLI's `--report` file (same keys in the same order, whole
+/// numbers from an `f64` as `float`, NaN as `None`).
+pub fn to_py<'py>(py: Python<'py>, value: &impl serde::Serialize) -> PyResult<Bound<'py, PyAny>> {
+    let text = serde_json::to_string(value)
+        .map_err(|e| errors::value(format!("cannot encode the result: {e}")))?;
+    py.import("json")?.getattr("loads")?.call1((text,))
+}

@@ -1,0 +1,604 @@
+//! The structured interior-point solver of `band`.
+//!
+//! In units of the tolerance `D` (the band is the unit ball around every input point `a_i`),
+//! and relative to a smooth reference `s` (the previous pass's result, or the input averaged
+//! for the first pass), the unknowns are `y = x − s` and the problem is
+//!
+//! ```text
+//! minimise  f(y) = E(s + y) = E(s) + 2 (A s)ᵀ y + yᵀ A y        (E(x) = xᵀ A x)
+//! subject to g_i(y) = |y_i − c_i|² − 1 ≤ 0   for every point i not held (c = a − s),
+//!            y_i = c_i                      for every held point,
+//! ```
+//!
+//! Working relative to a smooth `s` keeps the numbers small: for dense noisy data `E(a)` is
+//! orders of magnitude above the optimum, and `E(a) + 2(Aa)ᵀr + rᵀAr` would cancel away the
+//! digits the stopping rule needs.
+//!
+//! This is a convex quadratically constrained program with the same feasible set as the second-order
+//! cones `|q_i − p_i| ≤ D`. It is solved by an infeasible primal-dual interior-point method
+//! with Mehrotra's predictor-corrector (Nocedal & Wright, *Numerical Optimization*, §14.2 and
+//! §19.3): with slacks `σ_i` (`h_i + σ_i = 0`, `h_i = |y_i − c_i|² − 1`) and multipliers
+//! `λ_i`, each iteration linearises the conditions `∇f + Σ λ_i ∇h_i = 0`, `h + σ = 0`,
+//! `λ_i σ_i = μ`, takes an affine predictor step (target `μ = 0`), picks the centring
+//! `(μ_aff / μ)³` from how far it got, and takes the corrected step, 99 % of the way to the
+//! boundary of `λ, σ > 0`. Keeping the slacks as variables (rather than recomputing `−h`)
+//! keeps the digits of the points on the band's edge, where `h` would cancel.
+//!
+//! Eliminating `Δλ` and `Δσ` leaves one symmetric positive definite system per direction
+//! (see [`direction`]), `(2A + Σ_i [2λ_i I + (4λ_i / σ_i) r_i r_iᵀ]) Δy = …`,
+//!
+//! where the constraint terms are one D×D block per point on the diagonal: the matrix has the
+//! band of `A` (half-bandwidth `4D − 1` in the interleaved numbering, cyclic for closed
+//! curves), so a step is one banded `L D Lᵀ`, O(n). Tiny pivots (the energy has a null space:
+//! quadratics in t) are floored by static regularisation and the solve is corrected by a step
+//! of iterative refinement against the true matrix.
+
+use super::energy::Energy;
+use crate::error::{Error, Result};
+use crate::numeric::{CyclicSymBanded, SymBanded};
+
+/// How far towards the boundary of `λ ≥ 0`, `σ ≥ 0` a step may go.
+const STEP_TO_BOUNDARY: f64 = 0.99;
+/// The fraction of its slack a point must keep after a step.
+const SLACK_KEPT: f64 = 1e-3;
+/// The factor by which a step that leaves the band is shortened.
+const BACKTRACK: f64 = 0.5;
+/// The most shortenings of one step.
+const MAX_BACKTRACKS: usize = 60;
+/// Consecutive steps shorter than [`MIN_STEP`] before the run stops.
+const MAX_STALLS: usize = 3;
+/// The constraint residual `|r|² − 1 + σ` (in tolerances²) accepted at the end; the result is
+/// put into the band exactly afterwards.
+const PRIMAL_TOL: f64 = 1e-9;
+/// The objective below which the gap is measured absolutely, per free point (the problem is in
+/// units of the tolerance and the spacing, so this is scale-free).
+const OBJECTIVE_FLOOR: f64 = 1e-12;
+/// The gradient size below which the dual residual is measured absolutely.
+const GRADIENT_FLOOR: f64 = 1e-9;
+/// Stop when the surrogate duality gap is below this fraction of the objective (or of 1).
+pub(super) const GAP_REL: f64 = 1e-9;
+/// When rounding stops progress, the run still counts as converged if the gap is below this
+/// fraction of the objective.
+const ACCEPT_GAP_REL: f64 = 1e-6;
+/// A step shorter than this (after the step to the boundary and the shortening that keeps
+/// every point inside) makes no progress.
+const MIN_STEP: f64 = 1e-10;
+/// Stop when the dual residual is below this fraction of the size of its terms.
+const DUAL_RESIDUAL_REL: f64 = 1e-9;
+/// Static regularisation of the Newton matrix, relative to its largest diagonal entry.
+const REGULARIZATION_REL: f64 = 1e-13;
+/// Iterative refinement stops when the Newton residual is below this fraction of the
+/// right-hand side.
+const REFINEMENT_REL: f64 = 1e-10;
+/// How far from its input point (in tolerances) each point starts.
+const START_RADIUS: f64 = 0.9;
+/// The most refinement steps per Newton step.
+const MAX_REFINEMENTS: usize = 2;
+
+/// What [`solve`] needs.
+#[derive(Debug)]
+pub(super) struct Problem<'a, const D: usize> {
+    /// The energy `E(x) = xᵀ A x`.
+    pub energy: &'a Energy<D>,
+    /// `A s`: the energy's matrix applied to the reference.
+    pub anchor: Vec<f64>,
+    /// `E(s)`.
+    pub anchor_energy: f64,
+    /// The ball centres `c = a − s`, flat.
+    pub centres: Vec<f64>,
+    /// Points that may not move.
+    pub held: &'a [bool],
+    /// Newton steps allowed.
+    pub max_iterations: usize,
+}
+
+/// What [`solve`] found.
+#[derive(Clone, Debug)]
+pub(super) struct Solution {
+    /// Displacements from the input, `y − c`, in units of the tolerance, flat (`D` numbers a
+    /// point).
+    pub r: Vec<f64>,
+    /// The objective `f(r)`.
+    pub objective: f64,
+    /// Newton steps taken.
+    pub iterations: usize,
+    /// The final surrogate duality gap relative to `max(f, 1)`.
+    pub gap: f64,
+    /// Whether the stopping rule was met (else the iteration limit stopped it).
+    pub converged: bool,
+    /// The multipliers `λ_i` of the band constraints (0 for held points): with them, weak
+    /// duality bounds the optimum from below (the tests' certificate).
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub multipliers: Vec<f64>,
+}
+
+/// The Newton matrix: the energy's part assembled once, the constraint blocks added per step.
+enum Newton {
+    Open { base: SymBanded, work: SymBanded },
+    Closed { work: Option<CyclicSymBanded> },
+}
+
+impl Newton {
+    fn new<const D: usize>(energy: &Energy<D>, held: &[bool]) -> Newton {
+        let dim = energy.n * D;
+        let bw = 4 * D - 1;
+        if energy.closed {
+            return Newton::Closed { work: None };
+        }
+        let mut base = SymBanded::zeros(dim, bw);
+        energy.for_each_lower(2.0, |r, c, v| {
+            if !held[r / D] && !held[c / D] {
+                base.add(r, c, v);
+            }
+        });
+        for (i, _) in held.iter().enumerate().filter(|(_, h)| **h) {
+            for a in 0..D {
+                base.add(i * D + a, i * D + a, 1.0);
+            }
+        }
+        let work = base.clone();
+        Newton::Open { base, work }
+    }
+
+    /// Assemble `2A + blocks` (`blocks[i]` the D×D block of point i) and factorise it.
+    fn factorize<const D: usize>(
+        &mut self,
+        energy: &Energy<D>,
+        blocks: &[[[f64; D]; D]],
+        held: &[bool],
+    ) -> Result<()> {
+        match self {
+            Newton::Open { base, work } => {
+                work.assign(base);
+                let mut top = 0.0_f64;
+                for (i, b) in blocks.iter().enumerate() {
+                    if held[i] {
+                        continue;
+                    }
+                    for a in 0..D {
+                        for c in 0..=a {
+                            work.add(i * D + a, i * D + c, b[a][c]);
+                        }
+                    }
+                }
+                for k in 0..work.n() {
+                    top = top.max(work.get(k, k));
+                }
+                work.factorize_regularized(REGULARIZATION_REL * top)?;
+            }
+            Newton::Closed { work } => {
+                let dim = energy.n * D;
+                let mut m = CyclicSymBanded::zeros(dim, 4 * D - 1);
+                energy.for_each_lower(2.0, |r, c, v| m.add(r, c, v));
+                let mut top = 0.0_f64;
+                for (i, b) in blocks.iter().enumerate() {
+                    for a in 0..D {
+                        for c in 0..=a {
+                            m.add(i * D + a, i * D + c, b[a][c]);
+                        }
+                        top = top.max(m.get(i * D + a, i * D + a));
+                    }
+                }
+                for k in 0..dim {
+                    m.add(k, k, REGULARIZATION_REL * top);
+                }
+                m.factorize()?;
+                *work = Some(m);
+            }
+        }
+        Ok(())
+    }
+
+    fn solve(&self, rhs: &mut [f64]) -> Result<()> {
+        match self {
+            Newton::Open { work, .. } => work.solve_in_place(rhs),
+            Newton::Closed { work } => match work {
+                Some(m) => m.solve_in_place(rhs),
+                None => Err(Error::InvalidParameter {
+                    name: "band".into(),
+                    reason: "Newton solve before factorisation".into(),
+                }),
+            },
+        }
+    }
+}
+
+/// `out = K v` for the true Newton matrix `K = 2A + blocks` (held rows: the identity).
+fn newton_apply<const D: usize>(
+    energy: &Energy<D>,
+    blocks: &[[[f64; D]; D]],
+    held: &[bool],
+    v: &[f64],
+    out: &mut [f64],
+) {
+    out.fill(0.0);
+    energy.apply_add(v, out);
+    for o in out.iter_mut() {
+        *o *= 2.0;
+    }
+    for (i, b) in blocks.iter().enumerate() {
+        if held[i] {
+            for a in 0..D {
+                out[i * D + a] = v[i * D + a];
+            }
+            continue;
+        }
+        for a in 0..D {
+            out[i * D + a] += (0..D).map(|c| b[a][c] * v[i * D + c]).sum::<f64>();
+        }
+    }
+}
+
+/// `h = |r|² − 1`: the constraint, negative strictly inside the ball.
+#[inline]
+fn constraint(r: &[f64]) -> f64 {
+    r.iter().map(|x| x * x).sum::<f64>() - 1.0
+}
+
+fn norm_inf(v: &[f64]) -> f64 {
+    v.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
+}
+
+/// The starting point: each point moved from the reference towards its input point until it
+/// is at most [`START_RADIUS`] from it, so that every constraint holds strictly.
+fn start<const D: usize>(centres: &[f64], held: &[bool]) -> Vec<f64> {
+    let mut y = vec![0.0; centres.len()];
+    for (i, h) in held.iter().enumerate() {
+        let c = &centres[i * D..(i + 1) * D];
+        let len = c.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let theta = if *h {
+            1.0
+        } else if len > START_RADIUS {
+            1.0 - START_RADIUS / len
+        } else {
+            0.0
+        };
+        for a in 0..D {
+            y[i * D + a] = theta * c[a];
+        }
+    }
+    y
+}
+
+/// Whether the step `α Δy` keeps every free point strictly inside the band, with at least
+/// `1 − STEP_TO_BOUNDARY` of its slack.
+fn inside<const D: usize>(st: &State<D>, dy: &[f64], alpha: f64, held: &[bool]) -> bool {
+    (0..held.len()).all(|i| {
+        if held[i] {
+            return true;
+        }
+        let mut trial = [0.0; D];
+        for a in 0..D {
+            trial[a] = st.off[i * D + a] + alpha * dy[i * D + a];
+        }
+        -constraint(&trial) >= SLACK_KEPT * st.sig[i]
+    })
+}
+
+/// The longest step in `[0, 1]` along `(Δλ, Δσ)` that keeps `λ` and `σ` positive, times
+/// [`STEP_TO_BOUNDARY`] when it is limited (1 when it is not).
+fn step_length(lam: &[f64], dlam: &[f64], sig: &[f64], dsig: &[f64], held: &[bool]) -> f64 {
+    let mut longest = f64::INFINITY;
+    for i in 0..lam.len() {
+        if held[i] {
+            continue;
+        }
+        if dlam[i] < 0.0 {
+            longest = longest.min(-lam[i] / dlam[i]);
+        }
+        if dsig[i] < 0.0 {
+            longest = longest.min(-sig[i] / dsig[i]);
+        }
+    }
+    (STEP_TO_BOUNDARY * longest).min(1.0)
+}
+
+/// The working arrays of one run.
+struct State<const D: usize> {
+    y: Vec<f64>,
+    /// `y − c`: the displacement from the input point, in tolerances.
+    off: Vec<f64>,
+    lam: Vec<f64>,
+    /// The slacks `σ_i = −h_i` at feasibility, kept as variables so that a point close to the
+    /// band's edge keeps its digits.
+    sig: Vec<f64>,
+}
+
+/// Solve the band problem.
+///
+/// # Errors
+/// [`Error::Singular`] if a Newton matrix has non-finite entries (it cannot happen for
+/// finite input).
+pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
+    let energy = p.energy;
+    let n = energy.n;
+    let dim = n * D;
+    let held = p.held;
+    let free = held.iter().filter(|h| !**h).count();
+    let y = start::<D>(&p.centres, held);
+    let off: Vec<f64> = y.iter().zip(&p.centres).map(|(a, b)| a - b).collect();
+    let sig: Vec<f64> = (0..n)
+        .map(|i| {
+            if held[i] {
+                1.0
+            } else {
+                -constraint(&off[i * D..(i + 1) * D])
+            }
+        })
+        .collect();
+    let mut st = State::<D> {
+        y,
+        off,
+        lam: held.iter().map(|h| if *h { 0.0 } else { 1.0 }).collect(),
+        sig,
+    };
+    let mut newton = Newton::new(energy, held);
+    // The largest row sum of `|A|`.
+    let a_abs = {
+        let mut rows = vec![0.0_f64; dim];
+        energy.for_each_lower(1.0, |r, c, v| {
+            rows[r] += v.abs();
+            if r != c {
+                rows[c] += v.abs();
+            }
+        });
+        norm_inf(&rows)
+    };
+    let mut blocks = vec![[[0.0; D]; D]; n];
+    let mut ay = vec![0.0; dim];
+    let mut grad = vec![0.0; dim];
+    let mut rd = vec![0.0; dim];
+    let mut rp = vec![0.0; n];
+    let mut rc = vec![0.0; n];
+    let mut rp_corr = vec![0.0; n];
+    let mut dy = vec![0.0; dim];
+    let mut dlam = vec![0.0; n];
+    let mut dsig = vec![0.0; n];
+    let mut work = vec![0.0; dim];
+    let mut rhs = vec![0.0; dim];
+
+    let objective = |y: &[f64], ay: &[f64]| -> f64 {
+        let quad: f64 = y.iter().zip(ay).map(|(x, v)| x * v).sum();
+        let lin: f64 = y.iter().zip(&p.anchor).map(|(x, v)| x * v).sum();
+        p.anchor_energy + 2.0 * lin + quad
+    };
+
+    let mut iterations = 0;
+    let mut converged = free == 0;
+    let mut last_gap = 0.0;
+    let mut stalls = 0;
+    // Nothing to solve when every point is held.
+    while free > 0 && iterations <= p.max_iterations {
+        // Residuals at (y, λ, σ).
+        ay.fill(0.0);
+        energy.apply_add(&st.y, &mut ay);
+        for k in 0..dim {
+            grad[k] = 2.0 * (ay[k] + p.anchor[k]);
+        }
+        let mut gap = 0.0;
+        for i in 0..n {
+            if held[i] {
+                rp[i] = 0.0;
+                for a in 0..D {
+                    rd[i * D + a] = 0.0;
+                }
+                continue;
+            }
+            // Every iterate is strictly inside the band (the step below keeps it there), so
+            // the slack is the constraint's own value and the primal residual is zero.
+            st.sig[i] = -constraint(&st.off[i * D..(i + 1) * D]);
+            rp[i] = 0.0;
+            gap += st.lam[i] * st.sig[i];
+            for a in 0..D {
+                let k = i * D + a;
+                rd[k] = grad[k] + 2.0 * st.lam[i] * st.off[k];
+            }
+        }
+        let f = objective(&st.y, &ay);
+        let scale = f.abs().max(OBJECTIVE_FLOOR * free as f64);
+        last_gap = gap / scale;
+        let primal_ok = norm_inf(&rp) <= PRIMAL_TOL;
+        // The dual residual is measured against the size of the terms that make it up
+        // (`|A| |y|` bounds the rounding of `A y`), so that its rounding floor counts as zero.
+        let terms = (2.0 * a_abs * norm_inf(&st.y))
+            .max(2.0 * norm_inf(&p.anchor))
+            .max(norm_inf(&grad))
+            .max(GRADIENT_FLOOR);
+        let dual_ok = norm_inf(&rd) <= DUAL_RESIDUAL_REL * terms;
+        if gap <= GAP_REL * scale && primal_ok && dual_ok {
+            converged = true;
+            break;
+        }
+        if iterations >= p.max_iterations {
+            break;
+        }
+        iterations += 1;
+        let mu = gap / free as f64;
+
+        // The Newton matrix `2A + Σ [2λ_i I + (4λ_i/σ_i) r_i r_iᵀ]`, factorised once for
+        // both the predictor and the corrector.
+        for i in 0..n {
+            blocks[i] = [[0.0; D]; D];
+            if held[i] {
+                continue;
+            }
+            let w = 4.0 * st.lam[i] / st.sig[i];
+            for a in 0..D {
+                for c in 0..D {
+                    let id = if a == c { 2.0 * st.lam[i] } else { 0.0 };
+                    blocks[i][a][c] = id + w * st.off[i * D + a] * st.off[i * D + c];
+                }
+            }
+        }
+        // The iterate is strictly feasible at every step: if rounding makes the Newton system
+        // unusable (a non-finite pivot or direction, possible only near the end when many
+        // multipliers and slacks are both tiny), the run stops there with what it has.
+        if newton.factorize(energy, &blocks, held).is_err() {
+            break;
+        }
+
+        // Predictor (affine scaling): complementarity target 0.
+        for i in 0..n {
+            rc[i] = if held[i] { 0.0 } else { st.lam[i] * st.sig[i] };
+        }
+        if direction(
+            p, &newton, &blocks, &st, &rd, &rp, &rc, &mut dy, &mut dlam, &mut dsig, &mut rhs,
+            &mut work,
+        )
+        .is_err()
+        {
+            break;
+        }
+        let alpha_aff = step_length(&st.lam, &dlam, &st.sig, &dsig, held);
+        let mut gap_aff = 0.0;
+        for i in 0..n {
+            if !held[i] {
+                gap_aff += (st.lam[i] + alpha_aff * dlam[i]) * (st.sig[i] + alpha_aff * dsig[i]);
+            }
+        }
+        let centring = (gap_aff / gap).clamp(0.0, 1.0).powi(3);
+
+        // Corrector: the second-order terms of the predictor, centred at `centring · μ`. Two
+        // of them: `Δλ Δσ` in the complementarity (Mehrotra) and `|Δr|²` in the constraint,
+        // which is what a point sliding along the band's edge loses to the curvature of the
+        // edge (without it such a step leaves the band and is cut short).
+        for i in 0..n {
+            if held[i] {
+                rc[i] = 0.0;
+                rp_corr[i] = 0.0;
+                continue;
+            }
+            rc[i] = st.lam[i] * st.sig[i] + dlam[i] * dsig[i] - centring * mu;
+            let slide: f64 = (0..D).map(|a| dy[i * D + a] * dy[i * D + a]).sum();
+            rp_corr[i] = rp[i] + alpha_aff * slide;
+        }
+        if direction(
+            p, &newton, &blocks, &st, &rd, &rp_corr, &rc, &mut dy, &mut dlam, &mut dsig, &mut rhs,
+            &mut work,
+        )
+        .is_err()
+        {
+            break;
+        }
+        let mut alpha = step_length(&st.lam, &dlam, &st.sig, &dsig, held);
+        // The constraints are curved: a point sliding along the band's edge leaves it at
+        // second order. Shorten the step until every point keeps at least a fraction of its
+        // slack (the same rule as the step to the boundary of the linearised slack).
+        let mut tries = 0;
+        while tries < MAX_BACKTRACKS && !inside(&st, &dy, alpha, held) {
+            alpha *= BACKTRACK;
+            tries += 1;
+        }
+        if tries == MAX_BACKTRACKS {
+            alpha = 0.0;
+        }
+        if alpha < MIN_STEP {
+            stalls += 1;
+            if stalls >= MAX_STALLS {
+                break;
+            }
+        } else {
+            stalls = 0;
+        }
+        for k in 0..dim {
+            st.y[k] += alpha * dy[k];
+            st.off[k] += alpha * dy[k];
+        }
+        for i in 0..n {
+            if !held[i] {
+                st.lam[i] += alpha * dlam[i];
+                st.sig[i] += alpha * dsig[i];
+            }
+        }
+    }
+    // Stopped short of the stopping rule (by rounding): still counts as converged when the
+    // gap is small enough for the objective to be right to `ACCEPT_GAP_REL`.
+    converged |= last_gap <= ACCEPT_GAP_REL;
+    ay.fill(0.0);
+    energy.apply_add(&st.y, &mut ay);
+    let objective = objective(&st.y, &ay);
+    Ok(Solution {
+        r: st.off,
+        objective,
+        iterations,
+        gap: last_gap,
+        converged,
+        multipliers: st.lam,
+    })
+}
+
+/// One Newton direction for the complementarity residual `rc` (`λ_i σ_i` minus its target):
+///
+/// ```text
+/// K Δy = −r_d − Σ_i 2 r_i (λ_i r_p,i − r_c,i) / σ_i
+/// Δλ_i = (λ_i / σ_i) 2 r_i·Δy + (λ_i r_p,i − r_c,i) / σ_i
+/// Δσ_i = (−r_c,i − σ_i Δλ_i) / λ_i
+/// ```
+///
+/// with iterative refinement of `Δy` against the unregularised matrix.
+#[allow(clippy::too_many_arguments)]
+fn direction<const D: usize>(
+    p: &Problem<'_, D>,
+    newton: &Newton,
+    blocks: &[[[f64; D]; D]],
+    st: &State<D>,
+    rd: &[f64],
+    rp: &[f64],
+    rc: &[f64],
+    dy: &mut [f64],
+    dlam: &mut [f64],
+    dsig: &mut [f64],
+    rhs: &mut [f64],
+    work: &mut [f64],
+) -> Result<()> {
+    let held = p.held;
+    let n = held.len();
+    for i in 0..n {
+        if held[i] {
+            for a in 0..D {
+                rhs[i * D + a] = 0.0;
+            }
+            continue;
+        }
+        let t = (st.lam[i] * rp[i] - rc[i]) / st.sig[i];
+        for a in 0..D {
+            let k = i * D + a;
+            rhs[k] = -rd[k] - 2.0 * st.off[k] * t;
+        }
+    }
+    dy.copy_from_slice(rhs);
+    newton.solve(dy)?;
+    let rhs_size = norm_inf(rhs).max(f64::MIN_POSITIVE);
+    for _ in 0..MAX_REFINEMENTS {
+        newton_apply(p.energy, blocks, held, dy, work);
+        for k in 0..dy.len() {
+            work[k] = rhs[k] - work[k];
+        }
+        if norm_inf(work) <= REFINEMENT_REL * rhs_size {
+            break;
+        }
+        newton.solve(work)?;
+        for k in 0..dy.len() {
+            dy[k] += work[k];
+        }
+    }
+    for i in 0..n {
+        if held[i] {
+            dlam[i] = 0.0;
+            dsig[i] = 0.0;
+            continue;
+        }
+        let odot: f64 = (0..D).map(|a| st.off[i * D + a] * dy[i * D + a]).sum();
+        dlam[i] = (st.lam[i] / st.sig[i]) * 2.0 * odot + (st.lam[i] * rp[i] - rc[i]) / st.sig[i];
+        dsig[i] = (-rc[i] - st.sig[i] * dlam[i]) / st.lam[i];
+    }
+    let finite = dy
+        .iter()
+        .chain(dlam.iter())
+        .chain(dsig.iter())
+        .all(|v| v.is_finite());
+    if !finite {
+        return Err(Error::Singular("band: non-finite Newton direction".into()));
+    }
+    Ok(())
+}

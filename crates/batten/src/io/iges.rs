@@ -1,0 +1,885 @@
+//! IGES (`.igs`, `.iges`; fixed-form ASCII, IGES 5.3).
+//!
+//! An IGES file is a sequence of 80-column records: columns 1–72 hold data, column 73 the
+//! section letter (`S` start, `G` global, `D` directory entry, `P` parameter data, `T`
+//! terminate) and columns 74–80 the record's sequence number within its section. The global
+//! section starts with the parameter and record delimiters (default `,` and `;`, else given
+//! as Hollerith strings `1H,`). Every entity has two directory records of nine 8-column
+//! fields (type, pointer to its first parameter record, …, level, view, transformation
+//! matrix, …, status; then type, line weight, colour, parameter record count, form, …) and
+//! parameter records with data in columns 1–64 and a pointer back to the directory entry in
+//! 66–72. Strings are Hollerith (`5Hhello`); reals may use `D` or `E` exponents.
+//!
+//! Read: entity 126 (rational B-spline curve: K, M, PROP1–4, knots, weights, control points,
+//! V(0), V(1), normal) as a B-spline (without weights when PROP3 says polynomial or all
+//! weights are equal), and entity 106 (copious data) forms 1, 2, 11, 12 and 63 (closed) as
+//! points. Only independent entities count (subordinate switch 00 or 02); entities with a
+//! transformation matrix are refused, as are curves whose z varies (3-D curves are not
+//! supported yet) and 126 entities that use part of their parameter range. Which one:
+//! [`Pick::entity`] names the directory entry (its sequence number), [`Pick::layer`] the
+//! level; otherwise the only curve of the file.
+//!
+//! Write: a B-spline as entity 126, points as entity 106 form 11 (63 when closed), both at
+//! the origin's z, in millimetres. Reals are written as the shortest decimal that reads
+//! back bit for bit (`1.0D-1`), so a file batten writes reads back exactly.
+
+use std::fmt::Write as _;
+
+use std::path::Path;
+
+use super::{IoError, Location, Origin, Pick, Raw};
+use crate::geom::Point;
+use crate::spline::{BSplineCurve, KnotVector};
+
+/// Columns of a record.
+const RECORD: usize = 80;
+/// Data columns of S, G and D records.
+const DATA: usize = 72;
+/// Data columns of P records.
+const P_DATA: usize = 64;
+/// Relative tolerance (of the knot domain's length) within which V(0), V(1) of entity 126
+/// count as its whole domain: they are printed decimals of the end knots.
+const PARAM_RANGE_REL: f64 = 1e-9;
+/// IGES 5.3 version flag of the global section.
+const IGES_VERSION: i64 = 11;
+/// Units flag of written files: millimetres.
+const UNITS_MM: i64 = 2;
+
+fn err(path: &Path, line: usize, message: impl Into<String>) -> IoError {
+    IoError::Format {
+        path: path.to_path_buf(),
+        at: if line == 0 {
+            Location::File
+        } else {
+            Location::Line(line)
+        },
+        message: message.into(),
+    }
+}
+
+/// One record: its text (padded to 80 columns) and its 1-based line in the file.
+struct Rec {
+    text: Vec<u8>,
+    line: usize,
+}
+
+/// One directory entry.
+struct Dir {
+    /// Sequence number of its first D record (its "DE pointer").
+    de: usize,
+    line: usize,
+    kind: i64,
+    param: usize,
+    level: i64,
+    matrix: i64,
+    status: String,
+    param_count: usize,
+    form: i64,
+}
+
+/// Split the file into records by section.
+fn records(bytes: &[u8], path: &Path) -> Result<[Vec<Rec>; 5], IoError> {
+    let mut secs: [Vec<Rec>; 5] = Default::default();
+    let lines: Vec<&[u8]> = if !bytes.contains(&b'\n') && bytes.len() % RECORD == 0 {
+        bytes.chunks(RECORD).collect()
+    } else {
+        bytes.split(|&b| b == b'\n').collect()
+    };
+    for (i, raw) in lines.iter().enumerate() {
+        let line = i + 1;
+        let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
+        if raw.iter().all(u8::is_ascii_whitespace) {
+            continue;
+        }
+        if raw.len() > RECORD {
+            return Err(err(
+                path,
+                line,
+                format!("record of {} columns; IGES records have 80", raw.len()),
+            ));
+        }
+        if raw.len() < DATA + 1 {
+            return Err(err(
+                path,
+                line,
+                "record too short for a section letter in column 73 (not a fixed-form IGES file?)",
+            ));
+        }
+        let mut text = raw.to_vec();
+        text.resize(RECORD, b' ');
+        let idx = match text[DATA] {
+            b'S' => 0,
+            b'G' => 1,
+            b'D' => 2,
+            b'P' => 3,
+            b'T' => 4,
+            b'C' => {
+                return Err(err(
+                    path,
+                    line,
+                    "compressed IGES (section C) is not supported",
+                ));
+            }
+            c => {
+                return Err(err(
+                    path,
+                    line,
+                    format!(
+                        "unknown section letter '{}' in column 73",
+                        char::from(c).escape_debug()
+                    ),
+                ));
+            }
+        };
+        secs[idx].push(Rec { text, line });
+    }
+    if secs[1].is_empty() || secs[2].is_empty() {
+        return Err(err(
+            path,
+            0,
+            "no global (G) or directory (D) section: not an IGES file",
+        ));
+    }
+    Ok(secs)
+}
+
+/// Split free-format parameter data into tokens, up to the record delimiter. Hollerith
+/// strings (`3Habc`) are one token holding their text; other tokens are trimmed.
+fn tokens(data: &[u8], pd: u8, rd: u8) -> Result<Vec<String>, String> {
+    let mut out = Vec::new();
+    let mut i = 0;
+    loop {
+        while i < data.len() && data[i] == b' ' {
+            i += 1;
+        }
+        let start = i;
+        let mut j = i;
+        while j < data.len() && data[j].is_ascii_digit() {
+            j += 1;
+        }
+        if j > start && j < data.len() && data[j] == b'H' {
+            let n: usize = std::str::from_utf8(&data[start..j])
+                .ok()
+                .and_then(|s| s.parse().ok())
+                .ok_or("bad Hollerith length")?;
+            let end = j + 1 + n;
+            if end > data.len() {
+                return Err(format!(
+                    "Hollerith string of {n} characters runs past the data"
+                ));
+            }
+            out.push(String::from_utf8_lossy(&data[j + 1..end]).into_owned());
+            i = end;
+            while i < data.len() && data[i] == b' ' {
+                i += 1;
+            }
+        } else {
+            while i < data.len() && data[i] != pd && data[i] != rd {
+                i += 1;
+            }
+            out.push(String::from_utf8_lossy(&data[start..i]).trim().to_string());
+        }
+        match data.get(i) {
+            Some(&c) if c == pd => i += 1,
+            Some(&c) if c == rd => return Ok(out),
+            Some(&c) => {
+                return Err(format!(
+                    "expected a delimiter, found '{}'",
+                    char::from(c).escape_debug()
+                ));
+            }
+            None => return Err("the record delimiter is missing".into()),
+        }
+    }
+}
+
+fn int(tok: &str) -> Option<i64> {
+    if tok.is_empty() {
+        return Some(0);
+    }
+    tok.parse().ok()
+}
+
+fn real(tok: &str) -> Option<f64> {
+    if tok.is_empty() {
+        return Some(0.0);
+    }
+    let t = tok.replace(['D', 'd'], "e");
+    t.parse::<f64>().ok().filter(|v| v.is_finite())
+}
+
+/// The parameter and record delimiters of the global section.
+fn delimiters(g: &[u8]) -> Result<(u8, u8), String> {
+    let mut pd = b',';
+    let mut i = 0;
+    if g.starts_with(b"1H") && g.len() > 2 {
+        pd = g[2];
+        i = 3;
+    }
+    // After parameter 1 comes the parameter delimiter, then parameter 2.
+    if g.get(i) == Some(&pd) {
+        i += 1;
+    }
+    let rest = &g[i..];
+    let rd = if rest.starts_with(b"1H") && rest.len() > 2 {
+        rest[2]
+    } else {
+        b';'
+    };
+    if pd == rd {
+        return Err("the parameter and record delimiters are the same".into());
+    }
+    Ok((pd, rd))
+}
+
+fn field(rec: &Rec, k: usize) -> &str {
+    std::str::from_utf8(&rec.text[8 * k..8 * k + 8])
+        .unwrap_or("")
+        .trim()
+}
+
+/// Read the picked curve of an IGES file.
+pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Origin), IoError> {
+    let [_, g, d, p, _] = records(bytes, path)?;
+    let gdata: Vec<u8> = g.iter().flat_map(|r| r.text[..DATA].to_vec()).collect();
+    let (pd, rd) =
+        delimiters(&gdata).map_err(|m| err(path, g[0].line, format!("global section: {m}")))?;
+    if d.len() % 2 == 1 {
+        return Err(err(
+            path,
+            d[d.len() - 1].line,
+            "odd number of directory (D) records",
+        ));
+    }
+    let mut dirs = Vec::with_capacity(d.len() / 2);
+    for (k, pair) in d.chunks(2).enumerate() {
+        let (a, b) = (&pair[0], &pair[1]);
+        let bad = |rec: &Rec, f: usize| {
+            err(
+                path,
+                rec.line,
+                format!(
+                    "directory entry {}: field {} '{}' is not an integer",
+                    2 * k + 1,
+                    f,
+                    field(rec, (f - 1) % 9)
+                ),
+            )
+        };
+        let geti = |rec: &Rec, f: usize| int(field(rec, (f - 1) % 9)).ok_or_else(|| bad(rec, f));
+        dirs.push(Dir {
+            de: 2 * k + 1,
+            line: a.line,
+            kind: geti(a, 1)?,
+            param: usize::try_from(geti(a, 2)?).unwrap_or(0),
+            level: geti(a, 5)?,
+            matrix: geti(a, 7)?,
+            status: field(a, 8).to_string(),
+            param_count: usize::try_from(geti(b, 13)?).unwrap_or(0),
+            form: geti(b, 14)?,
+        });
+    }
+    let is_curve = |e: &Dir| {
+        let sub = e.status.get(2..4).unwrap_or("00");
+        let independent = matches!(sub, "00" | "02" | "" | "0");
+        independent && (e.kind == 126 || (e.kind == 106 && matches!(e.form, 1 | 2 | 11 | 12 | 63)))
+    };
+    let describe = |e: &Dir| {
+        format!(
+            "entity {} form {} at DE {} (level {})",
+            e.kind, e.form, e.de, e.level
+        )
+    };
+    let all: Vec<&Dir> = dirs.iter().filter(|e| is_curve(e)).collect();
+    let list = |v: &[&Dir]| {
+        if v.is_empty() {
+            "none".to_string()
+        } else {
+            v.iter().map(|e| describe(e)).collect::<Vec<_>>().join(", ")
+        }
+    };
+    let mut chosen = all.clone();
+    if let Some(de) = &pick.entity {
+        let want = de
+            .trim()
+            .trim_start_matches(['D', 'd'])
+            .parse::<usize>()
+            .ok();
+        chosen.retain(|e| Some(e.de) == want);
+        if chosen.is_empty() {
+            return Err(err(
+                path,
+                0,
+                format!(
+                    "no curve entity at directory entry {de} (curve entities: {})",
+                    list(&all)
+                ),
+            ));
+        }
+    }
+    if let Some(level) = &pick.layer {
+        let want = level.trim().parse::<i64>().ok();
+        chosen.retain(|e| Some(e.level) == want);
+        if chosen.is_empty() {
+            return Err(err(
+                path,
+                0,
+                format!(
+                    "no curve entity on level {level} (curve entities: {})",
+                    list(&all)
+                ),
+            ));
+        }
+    }
+    let e = match chosen.as_slice() {
+        [] => {
+            return Err(err(
+                path,
+                0,
+                "no entity 126 (B-spline curve) or 106 (copious data, forms 1, 2, 11, 12, 63)",
+            ));
+        }
+        [e] => *e,
+        many => {
+            return Err(err(
+                path,
+                0,
+                format!(
+                    "{} curve entities, pick one with --entity DE or --layer LEVEL: {}",
+                    many.len(),
+                    list(many)
+                ),
+            ));
+        }
+    };
+    let what = describe(e);
+    if e.matrix != 0 {
+        return Err(err(
+            path,
+            e.line,
+            format!(
+                "{what} has a transformation matrix (DE {}), which batten does not apply",
+                e.matrix
+            ),
+        ));
+    }
+    if e.param == 0 || e.param > p.len() || e.param - 1 + e.param_count.max(1) > p.len() {
+        return Err(err(
+            path,
+            e.line,
+            format!(
+                "{what}: its parameter data pointer {} (with {} records) is outside the P section of {} records",
+                e.param,
+                e.param_count,
+                p.len()
+            ),
+        ));
+    }
+    let recs = &p[e.param - 1..e.param - 1 + e.param_count.max(1)];
+    let data: Vec<u8> = recs
+        .iter()
+        .flat_map(|r| r.text[..P_DATA].to_vec())
+        .collect();
+    let pline = recs[0].line;
+    let toks = tokens(&data, pd, rd).map_err(|m| err(path, pline, format!("{what}: {m}")))?;
+    let fail = |m: String| err(path, pline, format!("{what}: {m}"));
+    let ti = |i: usize| -> Result<i64, IoError> {
+        let t = toks
+            .get(i)
+            .ok_or_else(|| fail(format!("{} parameters, more expected", toks.len())))?;
+        int(t).ok_or_else(|| fail(format!("parameter {i} '{t}' is not an integer")))
+    };
+    let tr = |i: usize| -> Result<f64, IoError> {
+        let t = toks
+            .get(i)
+            .ok_or_else(|| fail(format!("{} parameters, more expected", toks.len())))?;
+        real(t).ok_or_else(|| fail(format!("parameter {i} '{t}' is not a finite real")))
+    };
+    if ti(0)? != e.kind {
+        return Err(fail(format!(
+            "its parameter data starts with entity type '{}'",
+            toks.first().map_or("", String::as_str)
+        )));
+    }
+    let origin = Origin {
+        z: 0.0,
+        layer: Some(e.level.to_string()),
+        name: Some(e.de.to_string()),
+    };
+    let planar = |zs: &[f64]| -> Result<f64, IoError> {
+        match zs.iter().find(|&&z| z != zs[0]) {
+            Some(&z) => Err(fail(format!(
+                "z varies ({} and {z}): 3-D curves are not supported yet",
+                zs[0]
+            ))),
+            None => Ok(zs.first().copied().unwrap_or(0.0)),
+        }
+    };
+    if e.kind == 106 {
+        let ip = ti(1)?;
+        let n = usize::try_from(ti(2)?).map_err(|_| fail("negative point count".into()))?;
+        let (first, stride, zs) = match ip {
+            1 => (4, 2, None),
+            2 => (3, 3, Some(2)),
+            3 => (3, 6, Some(2)),
+            _ => {
+                return Err(fail(format!(
+                    "interpretation flag {ip}, expected 1, 2 or 3"
+                )));
+            }
+        };
+        let mut points = Vec::with_capacity(n);
+        let mut z = Vec::with_capacity(n);
+        for i in 0..n {
+            let b = first + stride * i;
+            points.push(Point::new(tr(b)?, tr(b + 1)?));
+            z.push(match zs {
+                Some(o) => tr(b + o)?,
+                None => tr(3)?,
+            });
+        }
+        let z = planar(&z)?;
+        let closed = e.form == 63;
+        if closed && points.len() > 1 && points.last() == points.first() {
+            points.pop();
+        }
+        let lines = vec![pline; points.len()];
+        return Ok((
+            Raw::Points {
+                points,
+                lines,
+                closed,
+            },
+            Origin { z, ..origin },
+        ));
+    }
+    // Entity 126.
+    let k = usize::try_from(ti(1)?).map_err(|_| fail("negative K".into()))?;
+    let m = usize::try_from(ti(2)?).map_err(|_| fail("negative degree M".into()))?;
+    let polynomial = ti(5)? == 1;
+    let nk = k + m + 2;
+    let kb = 7;
+    let wb = kb + nk;
+    let cb = wb + k + 1;
+    let vb = cb + 3 * (k + 1);
+    if toks.len() < vb + 2 {
+        return Err(fail(format!(
+            "{} parameters; K = {k}, M = {m} need at least {}",
+            toks.len(),
+            vb + 2
+        )));
+    }
+    let knots = (0..nk).map(|i| tr(kb + i)).collect::<Result<Vec<_>, _>>()?;
+    let weights = (0..=k).map(|i| tr(wb + i)).collect::<Result<Vec<_>, _>>()?;
+    let mut ctrl = Vec::with_capacity(k + 1);
+    let mut z = Vec::with_capacity(k + 1);
+    for i in 0..=k {
+        ctrl.push(Point::new(tr(cb + 3 * i)?, tr(cb + 3 * i + 1)?));
+        z.push(tr(cb + 3 * i + 2)?);
+    }
+    let z = planar(&z)?;
+    let (v0, v1) = (tr(vb)?, tr(vb + 1)?);
+    let weights = if polynomial || weights.iter().all(|&w| w == weights[0]) {
+        None
+    } else {
+        Some(weights)
+    };
+    let curve = KnotVector::try_new(knots)
+        .and_then(|kv| BSplineCurve::try_new(m, kv, ctrl, weights))
+        .map_err(|e| fail(e.to_string()))?;
+    let u = curve.knots().as_slice();
+    let (a, b) = (u[m], u[k + 1]);
+    let slack = PARAM_RANGE_REL * (b - a);
+    if v0 > a + slack || v1 < b - slack {
+        return Err(fail(format!(
+            "it uses the parameters [{v0}, {v1}] of its domain [{a}, {b}]; trimmed curves are not supported"
+        )));
+    }
+    Ok((Raw::Curve(curve), Origin { z, ..origin }))
+}
+
+/// A real in the shortest form that reads back bit for bit, with a decimal point and a `D`
+/// exponent: `1.0D-1`, `-2.5D3`, `0.0D0`.
+pub(crate) fn real_str(x: f64) -> String {
+    let s = format!("{x:e}");
+    let (mant, exp) = s.split_once('e').unwrap_or((&s, "0"));
+    if mant.contains('.') {
+        format!("{mant}D{exp}")
+    } else {
+        format!("{mant}.0D{exp}")
+    }
+}
+
+/// A Hollerith string.
+fn holl(s: &str) -> String {
+    format!("{}H{s}", s.len())
+}
+
+/// Today's date as IGES writes it: `YYYYMMDD.HHNNSS` (UTC).
+fn date_now() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let days = i64::try_from(secs / 86_400).unwrap_or(0);
+    let rem = secs % 86_400;
+    // Civil date from days since 1970-01-01 (H. Hinnant's algorithm).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}{month:02}{day:02}.{:02}{:02}{:02}",
+        rem / 3600,
+        rem % 3600 / 60,
+        rem % 60
+    )
+}
+
+/// Lay tokens into records of `width` columns, each token followed by `,` and the last by
+/// `;`, never splitting a token.
+fn lay(tokens: &[String], width: usize) -> Vec<String> {
+    let mut lines = vec![String::new()];
+    for (i, t) in tokens.iter().enumerate() {
+        let item = format!("{t}{}", if i + 1 == tokens.len() { ';' } else { ',' });
+        let cur = lines.last_mut().map_or(0, |l| l.len());
+        if cur > 0 && cur + item.len() > width {
+            lines.push(String::new());
+        }
+        if let Some(l) = lines.last_mut() {
+            l.push_str(&item);
+        }
+    }
+    lines
+}
+
+/// A whole IGES file with one entity.
+fn file(kind: i64, form: i64, params: &[String], max_coord: f64, origin: &Origin) -> String {
+    let mut out = String::new();
+    let rec = |out: &mut String, data: &str, sec: char, seq: usize| {
+        let _ = writeln!(out, "{data:<72}{sec}{seq:>7}");
+    };
+    let date = date_now();
+    let version = env!("CARGO_PKG_VERSION");
+    let s = ["batten: faired planar curve"];
+    for (i, l) in s.iter().enumerate() {
+        rec(&mut out, l, 'S', i + 1);
+    }
+    let g: Vec<String> = vec![
+        holl(","),
+        holl(";"),
+        holl("batten"),
+        holl(origin.name.as_deref().unwrap_or("curve")),
+        holl("batten"),
+        holl(version),
+        "32".into(),
+        "38".into(),
+        "6".into(),
+        "308".into(),
+        "15".into(),
+        holl("batten"),
+        real_str(1.0),
+        UNITS_MM.to_string(),
+        holl("MM"),
+        "1".into(),
+        real_str(1.0),
+        holl(&date),
+        real_str(1e-10),
+        real_str(max_coord),
+        String::new(),
+        String::new(),
+        IGES_VERSION.to_string(),
+        "0".into(),
+        holl(&date),
+    ];
+    let glines = lay(&g, DATA);
+    for (i, l) in glines.iter().enumerate() {
+        rec(&mut out, l, 'G', i + 1);
+    }
+    let plines = lay(params, P_DATA);
+    let level: i64 = origin
+        .layer
+        .as_deref()
+        .and_then(|l| l.parse().ok())
+        .unwrap_or(0);
+    let d1 = format!(
+        "{kind:>8}{:>8}{:>8}{:>8}{level:>8}{:>8}{:>8}{:>8}{:>8}",
+        1, 0, 0, 0, 0, 0, "00000000"
+    );
+    let label = if kind == 126 { "BSPLINE" } else { "COPIOUS" };
+    let d2 = format!(
+        "{kind:>8}{:>8}{:>8}{:>8}{form:>8}{:>8}{:>8}{label:>8}{:>8}",
+        0,
+        0,
+        plines.len(),
+        "",
+        "",
+        0
+    );
+    rec(&mut out, &d1, 'D', 1);
+    rec(&mut out, &d2, 'D', 2);
+    for (i, l) in plines.iter().enumerate() {
+        rec(&mut out, &format!("{l:<64}{:>8}", 1), 'P', i + 1);
+    }
+    let t = format!(
+        "S{:>7}G{:>7}D{:>7}P{:>7}",
+        s.len(),
+        glines.len(),
+        2,
+        plines.len()
+    );
+    rec(&mut out, &t, 'T', 1);
+    out
+}
+
+fn max_coordinate(points: &[Point], z: f64) -> f64 {
+    points
+        .iter()
+        .fold(z.abs(), |m, p| m.max(p.x.abs()).max(p.y.abs()))
+        .max(1.0)
+}
+
+/// Points as entity 106, form 11 (form 63 when closed).
+pub(crate) fn format_points(points: &[Point], closed: bool, origin: &Origin) -> String {
+    let mut params = vec![
+        "106".to_string(),
+        "1".into(),
+        points.len().to_string(),
+        real_str(origin.z),
+    ];
+    for p in points {
+        params.push(real_str(p.x));
+        params.push(real_str(p.y));
+    }
+    let form = if closed { 63 } else { 11 };
+    file(106, form, &params, max_coordinate(points, origin.z), origin)
+}
+
+/// A B-spline as entity 126 (planar, normal +z).
+pub(crate) fn format_curve(curve: &BSplineCurve, closed: bool, origin: &Origin) -> String {
+    let ctrl = curve.control_points();
+    let k = ctrl.len() - 1;
+    let m = curve.degree();
+    let u = curve.knots().as_slice();
+    let mut params: Vec<String> = vec![
+        "126".into(),
+        k.to_string(),
+        m.to_string(),
+        "1".into(),
+        u8::from(closed).to_string(),
+        u8::from(curve.weights().is_none()).to_string(),
+        "0".into(),
+    ];
+    params.extend(u.iter().map(|&x| real_str(x)));
+    match curve.weights() {
+        Some(w) => params.extend(w.iter().map(|&x| real_str(x))),
+        None => params.extend(std::iter::repeat_n(real_str(1.0), k + 1)),
+    }
+    for p in ctrl {
+        params.extend([real_str(p.x), real_str(p.y), real_str(origin.z)]);
+    }
+    params.extend([real_str(u[m]), real_str(u[k + 1])]);
+    params.extend([real_str(0.0), real_str(0.0), real_str(1.0)]);
+    file(126, 0, &params, max_coordinate(ctrl, origin.z), origin)
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    fn read(text: &str, pick: &Pick) -> Result<(Raw, Origin), String> {
+        parse(text.as_bytes(), Path::new("c.igs"), pick).map_err(|e| e.to_string())
+    }
+
+    fn curve() -> BSplineCurve {
+        let knots =
+            KnotVector::try_new(vec![0., 0., 0., 0., 0.3, 1.0 / 3.0, 1., 1., 1., 1.]).unwrap();
+        let ctrl = vec![
+            Point::new(0.1, -1.0 / 3.0),
+            Point::new(1e-300, 2.5),
+            Point::new(3.0, 1e5 / 7.0),
+            Point::new(-4.0, 0.0),
+            Point::new(5.0, -2.0),
+            Point::new(6.0, f64::MAX / 3.0),
+        ];
+        BSplineCurve::try_new(3, knots, ctrl, Some(vec![1.0, 0.5, 2.0, 1.0, 1.0, 0.75])).unwrap()
+    }
+
+    #[test]
+    fn reals_are_exact_with_a_point_and_d_exponent() {
+        assert_eq!(real_str(0.1), "1.0D-1");
+        assert_eq!(real_str(-2500.0), "-2.5D3");
+        assert_eq!(real_str(0.0), "0.0D0");
+        for x in [
+            0.1,
+            -1.0 / 3.0,
+            1e-300,
+            5e-324,
+            f64::MAX,
+            -0.0,
+            123456789.125,
+        ] {
+            assert_eq!(real(&real_str(x)).unwrap().to_bits(), x.to_bits(), "{x}");
+        }
+        assert_eq!(real("1."), Some(1.0));
+        assert_eq!(real(".5E1"), Some(5.0));
+        assert_eq!(real("2d2"), Some(200.0));
+    }
+
+    #[test]
+    fn records_are_80_columns_and_the_curve_reads_back_bit_for_bit() {
+        let c = curve();
+        let origin = Origin {
+            z: 7.5,
+            layer: Some("3".into()),
+            name: None,
+        };
+        let text = format_curve(&c, false, &origin);
+        assert!(text.lines().all(|l| l.len() == 80), "{text}");
+        let (raw, o) = read(&text, &Pick::default()).unwrap();
+        let Raw::Curve(back) = raw else { panic!() };
+        assert_eq!(back, c);
+        assert_eq!(o.z, 7.5);
+        assert_eq!(o.layer.as_deref(), Some("3"));
+        assert_eq!(o.name.as_deref(), Some("1"));
+        // Polynomial: no weights.
+        let plain =
+            BSplineCurve::try_new(3, c.knots().clone(), c.control_points().to_vec(), None).unwrap();
+        let (raw, _) = read(
+            &format_curve(&plain, false, &Origin::default()),
+            &Pick::default(),
+        )
+        .unwrap();
+        assert_eq!(raw_curve(raw), plain);
+    }
+
+    fn raw_curve(r: Raw) -> BSplineCurve {
+        match r {
+            Raw::Curve(c) => c,
+            Raw::Points { .. } => panic!("points"),
+        }
+    }
+
+    #[test]
+    fn copious_data_round_trip_open_and_closed() {
+        let pts: Vec<Point> = (0..40)
+            .map(|i| Point::new(f64::from(i) / 7.0, (f64::from(i) * 0.3).sin()))
+            .collect();
+        for closed in [false, true] {
+            let text = format_points(
+                &pts,
+                closed,
+                &Origin {
+                    z: -1.0,
+                    ..Origin::default()
+                },
+            );
+            let (raw, o) = read(&text, &Pick::default()).unwrap();
+            let Raw::Points {
+                points, closed: c, ..
+            } = raw
+            else {
+                panic!()
+            };
+            assert_eq!(points, pts);
+            assert_eq!(c, closed);
+            assert_eq!(o.z, -1.0);
+        }
+    }
+
+    /// A file in the style of other writers: delimiters defaulted, reals as `1.`, `E`
+    /// exponents, two entities, a 3-D polyline.
+    const TWO: &str = "\
+Hand-made test file                                                     S      1
+,,4Htest,5Hx.igs,4Htest,3H1.0,32,38,6,308,15,4Htest,1.,2,2HMM,1,1.,     G      1
+15H20240101.000000,1.E-08,10.,,,11,0,15H20240101.000000;                G      2
+     106       1       0       0       0       0       0       000000000D      1
+     106       0       0       1      11                               0D      2
+     106       2       0       0       5       0       0       000000000D      3
+     106       0       0       2      12                               0D      4
+106,1,4,0.,0.,0.,1.,0.,1.,1.,2.,1.5E0;                                 1P      1
+106,2,4,0.,0.,0.,1.,0.,0.,1.,1.,1.,2.,1.5,                             3P      2
+2.;                                                                    3P      3
+S      1G      2D      4P      3                                        T      1
+";
+
+    #[test]
+    fn other_writers_style_picking_and_3d_refusal() {
+        let e = read(TWO, &Pick::default()).unwrap_err();
+        assert_eq!(
+            e,
+            "c.igs: 2 curve entities, pick one with --entity DE or --layer LEVEL: entity 106 form 11 at DE 1 (level 0), entity 106 form 12 at DE 3 (level 5)"
+        );
+        let (raw, o) = read(TWO, &Pick::default().with_entity(Some("1".into()))).unwrap();
+        let Raw::Points { points, lines, .. } = raw else {
+            panic!()
+        };
+        assert_eq!(points[3], Point::new(2.0, 1.5));
+        assert_eq!(lines, vec![8; 4]);
+        assert_eq!(o.z, 0.0);
+        let e = read(TWO, &Pick::default().with_layer(Some("5".into()))).unwrap_err();
+        assert_eq!(
+            e,
+            "c.igs:9: entity 106 form 12 at DE 3 (level 5): z varies (0 and 1): 3-D curves are not supported yet"
+        );
+        let e = read(TWO, &Pick::default().with_entity(Some("7".into()))).unwrap_err();
+        assert!(
+            e.starts_with(
+                "c.igs: no curve entity at directory entry 7 (curve entities: entity 106"
+            ),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn malformed_files_name_the_line() {
+        let e = read("hello\n", &Pick::default()).unwrap_err();
+        assert_eq!(
+            e,
+            "c.igs:1: record too short for a section letter in column 73 (not a fixed-form IGES file?)"
+        );
+        let bad = TWO.replace(
+            "106,1,4,0.,0.,0.,1.,0.,1.,1.,2.,1.5E0;",
+            "106,1,4,0.,0.,0.,1.,0.,1.,1.,2.,x.5E0;",
+        );
+        let e = read(&bad, &Pick::default().with_entity(Some("1".into()))).unwrap_err();
+        assert_eq!(
+            e,
+            "c.igs:8: entity 106 form 11 at DE 1 (level 0): parameter 11 'x.5E0' is not a finite real"
+        );
+        let bad = TWO.replace(
+            "106,1,4,0.,0.,0.,1.,0.,1.,1.,2.,1.5E0;",
+            "106,1,5,0.,0.,0.,1.,0.,1.,1.,2.,1.5E0;",
+        );
+        let e = read(&bad, &Pick::default().with_entity(Some("1".into()))).unwrap_err();
+        assert_eq!(
+            e,
+            "c.igs:8: entity 106 form 11 at DE 1 (level 0): 12 parameters, more expected"
+        );
+        let bad = TWO.replace(
+            "     106       1       0       0       0       0       0       000000000D      1",
+            "     106      99       0       0       0       0       0       000000000D      1",
+        );
+        let e = read(&bad, &Pick::default().with_entity(Some("1".into()))).unwrap_err();
+        assert!(
+            e.starts_with(
+                "c.igs:4: entity 106 form 11 at DE 1 (level 0): its parameter data pointer 99"
+            ),
+            "{e}"
+        );
+        let e = read(
+            &TWO.replace(
+                ";                                 1P",
+                ",                                 1P",
+            ),
+            &Pick::default().with_entity(Some("1".into())),
+        )
+        .unwrap_err();
+        assert!(e.ends_with("the record delimiter is missing"), "{e}");
+    }
+}
