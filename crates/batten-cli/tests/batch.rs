@@ -168,7 +168,7 @@ fn mixed_directory_writes_good_files_and_reports_the_bad_one() {
     let json = read_json(&out.join("d.json"));
     assert_eq!(json["points"].as_array().unwrap().len(), 32);
     let report = read_json(&out.join("a.report.json"));
-    assert_eq!(report["method"], "han");
+    assert_eq!(report["method"], "band");
     assert_eq!(report["tolerance_met"], true);
     assert_eq!(report["before"]["points"], 30);
 
@@ -451,7 +451,7 @@ fn bad_options_exit_2_and_write_nothing() {
         (&["--method", "nope"], &["unknown method 'nope'", "mst"]),
         (
             &["--set", "bogus=1"],
-            &["unknown option 'bogus' for method han"],
+            &["unknown option 'bogus' for method band"],
         ),
         (&["--set", "p"], &["malformed --set 'p'"]),
         (&["--tolerance=-1"], &["tolerance", "positive"]),

@@ -192,13 +192,10 @@ fn bad_options_exit_2_before_anything_runs() {
     };
     let cases: &[(&[&str], &[&str])] = &[
         (&["--method", "nope"], &["unknown method 'nope'", "mst"]),
-        // The default method, han.
+        // The default method, band.
         (
             &["--set", "bogus=1"],
-            &[
-                "unknown option 'bogus' for method han",
-                "known: lambda_coarse",
-            ],
+            &["unknown option 'bogus' for method band", "known: k, energy"],
         ),
         (
             &["--set", "lambda_fine"],
@@ -211,11 +208,8 @@ fn bad_options_exit_2_before_anything_runs() {
         ),
         (&["--tolerance=-1"], &["tolerance", "positive"]),
         (&["--tolerance", "nan"], &["tolerance", "positive"]),
-        (
-            &["--set", "lambda_fine=abc"],
-            &["'abc' is not a finite number"],
-        ),
-        (&["--set", "lambda_fine=2"], &["2 is outside [0, 1]"]),
+        (&["--set", "eps=abc"], &["'abc' is not a finite number"]),
+        (&["--set", "eps=20"], &["20 is outside [0, 10]"]),
         // Another method's parameters.
         (
             &["--method", "mst", "--set", "bogus=1"],
@@ -342,7 +336,7 @@ fn fair_round_trip_writes_points_and_report() {
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let err = stderr(&o);
     assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(err.starts_with("han: "), "{err}");
+    assert!(err.starts_with("band: "), "{err}");
     assert!(err.contains("max displacement"), "{err}");
     assert!(o.stdout.is_empty());
     assert_eq!(read_csv_points(&out).len(), 30);
@@ -360,7 +354,7 @@ fn fair_round_trip_writes_points_and_report() {
     ] {
         assert!(r.get(key).is_some(), "report lacks {key}: {r}");
     }
-    assert_eq!(r["method"], "han");
+    assert_eq!(r["method"], "band");
     assert_eq!(r["tolerance_met"], true);
     assert_eq!(r["before"]["points"], 30);
     assert_eq!(r["after"]["points"], 30);

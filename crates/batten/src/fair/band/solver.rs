@@ -108,7 +108,7 @@ pub(super) struct Solution {
     pub converged: bool,
     /// The multipliers `λ_i` of the band constraints (0 for held points): with them, weak
     /// duality bounds the optimum from below (the tests' certificate).
-    #[cfg_attr(not(test), allow(dead_code))]
+    #[allow(dead_code)]
     pub multipliers: Vec<f64>,
 }
 
