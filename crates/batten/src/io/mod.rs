@@ -294,12 +294,16 @@ fn validate(
             index,
             previous,
             relative,
-        }) => Err(IoError::NearDuplicate {
-            path: path.to_path_buf(),
-            line: line(index),
-            other: line(previous),
-            relative,
-        }),
+        }) => {
+            // The closing chord of a closed curve comes as (first, last): name the later line.
+            let (a, b) = (line(index), line(previous));
+            Err(IoError::NearDuplicate {
+                path: path.to_path_buf(),
+                line: a.max(b),
+                other: a.min(b),
+                relative,
+            })
+        }
         Err(source) => Err(IoError::Invalid {
             path: path.to_path_buf(),
             source,
