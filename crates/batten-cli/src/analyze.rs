@@ -9,6 +9,7 @@ use batten::FairnessMetrics;
 use crate::AnalyzeArgs;
 use crate::failure::Failure;
 use crate::output::{self, sig};
+use crate::spinner::Spinner;
 use crate::{formats, input};
 
 /// Significant digits of real numbers in the table.
@@ -21,8 +22,10 @@ const DIGITS: usize = 6;
 pub fn run(args: &AnalyzeArgs) -> Result<ExitCode, Failure> {
     let data = input::read_picked(&args.input, args.closed, &args.pick)?;
     let name = formats::display_name(&args.input).display().to_string();
+    let spinner = Spinner::start(format!("analysing {} points", data.seq.len()));
     let metrics = FairnessMetrics::of_seq(&data.seq)
         .map_err(|e| Failure::from_batten(&format!("{name}: cannot analyse"), e))?;
+    spinner.finish();
     let text = if args.json {
         let mut s = serde_json::to_string_pretty(&metrics)
             .map_err(|e| Failure::failed(anyhow!("cannot encode the metrics: {e}")))?;

@@ -24,10 +24,10 @@ use std::ffi::OsString;
 use std::fmt::Write as _;
 use std::fs;
 use std::io::IsTerminal as _;
-use std::num::NonZeroUsize;
 use std::panic::{self, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::{Arc, Mutex};
 
 use anyhow::anyhow;
 use batten::FairOptions;
@@ -41,10 +41,19 @@ use serde::Serialize;
 use crate::compare::{csv_field, csv_num};
 use crate::failure::{EXIT_FAILED, EXIT_USAGE, Failure};
 use crate::output::{self, sig};
-use crate::{fair_cmd, input};
+use crate::{fair_cmd, input, signals};
 
 /// Significant digits of displacements in messages.
 const DIGITS: usize = 4;
+
+/// Most files faired at once (`--jobs`): each is a thread with its own curve in memory, and
+/// thousands of threads only cost time to start (30000 took minutes for one file).
+const MAX_JOBS: usize = 1024;
+
+/// `--jobs N` (clap value parser): 1 to [`MAX_JOBS`].
+fn parse_jobs(s: &str) -> Result<usize, String> {
+    input::parse_count(s, MAX_JOBS)
+}
 
 /// Suffix of the report written beside each output: `NAME.csv` → `NAME.report.json`.
 const REPORT_SUFFIX: &str = ".report.json";
@@ -73,8 +82,9 @@ pub struct BatchArgs {
     #[arg(long, value_name = "WHAT", num_args = 0..=1, require_equals = true,
           default_missing_value = "position", value_parser = input::parse_end_fix)]
     fix_ends: Option<EndFix>,
-    /// Upper bound on the method's iterations (its own unit: sweeps, moves or passes)
-    #[arg(long, value_name = "N")]
+    /// Upper bound on the method's iterations (its own unit: sweeps, moves or passes), 1 to
+    /// 1000000
+    #[arg(long, value_name = "N", value_parser = input::parse_max_iterations)]
     max_iterations: Option<usize>,
     /// A method parameter, KEY=VALUE (repeat for several; see `batten methods`)
     #[arg(long = "set", value_name = "KEY=VALUE")]
@@ -83,10 +93,10 @@ pub struct BatchArgs {
     /// displacements, metrics before and after) to this .json or .csv file
     #[arg(long, value_name = "FILE")]
     summary: Option<PathBuf>,
-    /// Files faired at once [default: one per core; more can help where writes wait for a
-    /// slow disk, as every file is synced]
-    #[arg(long, value_name = "N")]
-    jobs: Option<NonZeroUsize>,
+    /// Files faired at once, 1 to 1024 and never more than the files [default: one per core;
+    /// more can help where writes wait for a slow disk, as every file is synced]
+    #[arg(long, value_name = "N", value_parser = parse_jobs)]
+    jobs: Option<usize>,
 }
 
 /// How one input ended.
@@ -101,6 +111,9 @@ enum Status {
     Failed,
     /// The file could not be read, or its data or its closedness was rejected.
     InvalidInput,
+    /// The batch was interrupted (SIGINT, SIGTERM) before this file finished; nothing of it
+    /// was written. Only in the summary an interrupted batch leaves.
+    Interrupted,
 }
 
 impl Status {
@@ -111,12 +124,13 @@ impl Status {
             Status::ToleranceExceeded => "tolerance_exceeded",
             Status::Failed => "failed",
             Status::InvalidInput => "invalid_input",
+            Status::Interrupted => "interrupted",
         }
     }
 }
 
 /// One input: where it is read from and where its results go.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 struct Job {
     input: PathBuf,
     output: PathBuf,
@@ -125,7 +139,7 @@ struct Job {
 
 /// One row of the summary. Fields that are not known for a row (the metrics of a file that
 /// could not be read) are `null` in JSON and empty in CSV.
-#[derive(Debug, Serialize)]
+#[derive(Clone, Debug, Serialize)]
 struct Row {
     file: String,
     status: Status,
@@ -216,23 +230,65 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
     if let Some(path) = &args.summary {
         check_summary(path, &jobs, &args.out_dir)?;
     }
-    fs::create_dir_all(&args.out_dir).map_err(|e| {
-        Failure::failed(anyhow!(
-            "{}: cannot create directory: {e}",
-            args.out_dir.display()
-        ))
-    })?;
+    create_out_dir(&args.out_dir, args.summary.as_deref())?;
 
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.jobs.map_or(0, NonZeroUsize::get))
+        // More threads than files would only idle.
+        .num_threads(args.jobs.map_or(0, |n| n.min(jobs.len())))
         .build()
         .map_err(|e| Failure::failed(anyhow!("cannot start worker threads: {e}")))?;
     let bar = progress_bar(jobs.len());
+    // The rows of the files that have finished (a DXF file gives one per curve), for the
+    // summary an interrupt leaves.
+    let finished: Arc<Mutex<Vec<Option<Vec<Row>>>>> = Arc::new(Mutex::new(vec![None; jobs.len()]));
+    if let (Some(path), Some(format)) = (&args.summary, summary_format) {
+        let (finished, jobs, path) = (Arc::clone(&finished), jobs.clone(), path.clone());
+        signals::set_last_word(move || {
+            let slots = std::mem::take(&mut *finished.lock().unwrap_or_else(|e| e.into_inner()));
+            let done = slots.iter().filter(|r| r.is_some()).count();
+            let files = slots.len();
+            let rows: Vec<Row> = slots
+                .into_iter()
+                .zip(&jobs)
+                .flat_map(|(rows, job)| {
+                    rows.unwrap_or_else(|| {
+                        let why = "batch interrupted before this file finished".to_string();
+                        vec![Row::new(job, Status::Interrupted, Some(why), None, None)]
+                    })
+                })
+                .collect();
+            let text = match format {
+                SummaryFormat::Json => summary_json(&rows),
+                SummaryFormat::Csv => Ok(summary_csv(&rows)),
+            };
+            Some(
+                match text
+                    .and_then(|t| io::write_atomic(&path, t.as_bytes()).map_err(|e| e.to_string()))
+                {
+                    Ok(()) => format!(
+                        "summary of the {done} of {} that finished written to {}, the others \
+                         marked interrupted",
+                        output::count(files, "file"),
+                        path.display()
+                    ),
+                    Err(e) => format!("summary not written: {e}"),
+                },
+            )
+        });
+    }
     let rows: Vec<Row> = pool.install(|| {
         let per_job: Vec<Vec<Row>> = jobs
             .par_iter()
-            .map(|job| {
+            .enumerate()
+            .map(|(i, job)| {
                 let rows = fair_one(job, method, &options);
+                if let Some(slot) = finished
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .get_mut(i)
+                {
+                    *slot = Some(rows.clone());
+                }
                 bar.inc(1);
                 rows
             })
@@ -256,6 +312,7 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
             output::error_line(message);
         }
     }
+    signals::clear_last_word();
     let summary_failed = summary_written.is_err();
     if let Err(message) = summary_written {
         output::error_line(&message);
@@ -270,9 +327,9 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
         format!(", {} curves", rows.len())
     };
     output::note(&format!(
-        "batch: {} files{curves}: {ok} ok, {exceeded} tolerance exceeded, {failed} failed, \
+        "batch: {}{curves}: {ok} ok, {exceeded} tolerance exceeded, {failed} failed, \
          {invalid} invalid input; results in {}",
-        jobs.len(),
+        output::count(jobs.len(), "file"),
         args.out_dir.display()
     ));
     Ok(if invalid > 0 {
@@ -282,6 +339,50 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
     } else {
         ExitCode::SUCCESS
     })
+}
+
+/// Create the output directory (and its parents) and check that a file can be written in it,
+/// and that the summary can be written once the directory exists. On failure, every
+/// directory this created is removed again: a usage error leaves nothing behind.
+///
+/// # Errors
+/// [`Failure::usage`] (exit 2) naming the directory or the summary.
+fn create_out_dir(out_dir: &Path, summary: Option<&Path>) -> Result<(), Failure> {
+    // The first missing ancestor: what to remove if a check fails.
+    let mut created = None;
+    let mut p = out_dir;
+    while !p.as_os_str().is_empty() && !p.exists() {
+        created = Some(p.to_path_buf());
+        p = p.parent().unwrap_or(Path::new(""));
+    }
+    let checked = fs::create_dir_all(out_dir)
+        .map_err(|e| {
+            Failure::usage(anyhow!(
+                "{}: cannot write: cannot create the directory: {e}",
+                out_dir.display()
+            ))
+        })
+        .and_then(|()| {
+            fair_cmd::check_writable(&out_dir.join("probe.json")).map_err(|_| {
+                Failure::usage(anyhow!(
+                    "{}: cannot write: no file can be created in the directory",
+                    out_dir.display()
+                ))
+            })
+        })
+        .and_then(|()| summary.map_or(Ok(()), fair_cmd::check_writable));
+    if checked.is_err()
+        && let Some(top) = created
+    {
+        // Best effort: only directories this run created, and only when still empty.
+        let mut d = out_dir.to_path_buf();
+        while fs::remove_dir(&d).is_ok() && d != top {
+            if !d.pop() {
+                break;
+            }
+        }
+    }
+    checked
 }
 
 /// A progress bar on stderr, hidden when stderr is not a terminal (tests, CI, logs).
@@ -466,16 +567,14 @@ fn fair_dxf(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> Vec<Ro
             report: &f.report,
         })
         .collect();
-    let written = drawing
-        .to_bytes()
-        .and_then(|b| io::write_atomic(&job.output, &b))
-        .map_err(|e| e.to_string())
-        .and_then(|()| {
-            let mut json = serde_json::to_string_pretty(&reports)
-                .map_err(|e| format!("cannot encode the reports: {e}"))?;
-            json.push('\n');
-            io::write_atomic(&job.report, json.as_bytes()).map_err(|e| e.to_string())
-        });
+    // The reports and the drawing as one set, the reports first (as `batten fair` does).
+    let written = drawing.to_bytes().map_err(|e| e.to_string()).and_then(|b| {
+        let mut json = serde_json::to_string_pretty(&reports)
+            .map_err(|e| format!("cannot encode the reports: {e}"))?;
+        json.push('\n');
+        io::write_atomic_set(&[(&job.report, json.as_bytes()), (&job.output, &b)])
+            .map_err(|e| e.to_string())
+    });
     if let Err(message) = written {
         for r in &mut rows {
             if matches!(r.status, Status::Ok | Status::ToleranceExceeded) {
@@ -517,10 +616,16 @@ fn fair_one_inner(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> 
     let report = &faired.report;
     // Tangents: the method's, else the input's carried through (as `batten fair` does).
     let tangents = faired.tangents.as_deref().or(data.tangents.as_deref());
-    let written = io::write_points(&job.output, &faired.points, data.seq.is_closed(), tangents)
+    // The report and the points as one set, the report first (as `batten fair` does).
+    let written = io::encode_points(&job.output, &faired.points, data.seq.is_closed(), tangents)
         .map_err(|e| e.to_string())
-        .and_then(|()| {
-            fair_cmd::write_report(&job.report, report).map_err(|f| f.error.to_string())
+        .and_then(|points| {
+            let report = fair_cmd::report_json(report).map_err(|f| f.error.to_string())?;
+            io::write_atomic_set(&[
+                (&job.report, report.as_bytes()),
+                (&job.output, points.as_slice()),
+            ])
+            .map_err(|e| e.to_string())
         });
     let (status, error) = match written {
         Err(message) => (Status::Failed, Some(message)),
@@ -580,8 +685,16 @@ fn expand(args: &[PathBuf]) -> Result<Vec<PathBuf>, Failure> {
                 )));
             }
             inputs.extend(found);
+        } else if !arg.exists() && Format::from_path(arg).is_err() {
+            // Not a point file by name, and nothing there: most likely a folder that is not
+            // there (`scans/`). Say so, rather than "unknown file format" for each.
+            return Err(Failure::usage(anyhow!(
+                "{}: no such file or directory",
+                arg.display()
+            )));
         } else {
-            // A file, or a path that does not exist: reading it reports what is wrong.
+            // A file, or a point file that does not exist: reading it reports what is wrong,
+            // as a row of the summary.
             inputs.push(arg.clone());
         }
     }
@@ -761,14 +874,8 @@ fn check_summary(path: &Path, jobs: &[Job], out_dir: &Path) -> Result<(), Failur
             (fs::canonicalize(dir), fs::canonicalize(out_dir)),
             (Ok(a), Ok(b)) if a == b
         );
-    if path.is_dir() {
-        return Err(Failure::usage(anyhow!(
-            "--summary {}: is a directory",
-            path.display()
-        )));
-    }
-    if !in_out_dir {
-        fair_cmd::check_directory(path)?;
+    if path.is_dir() || !in_out_dir {
+        fair_cmd::check_writable(path)?;
     }
     if let Ok(real) = fs::canonicalize(path) {
         for job in jobs {

@@ -12,6 +12,7 @@ use batten::{Faired, PointSeq, analysis};
 use crate::FairArgs;
 use crate::failure::{EXIT_FAILED, Failure};
 use crate::output::{self, sig};
+use crate::spinner::Spinner;
 use crate::{formats, input};
 
 /// Significant digits in the summary line.
@@ -43,10 +44,10 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         .check(in_format, &input_name.display().to_string())?;
     let to_stdout = formats::is_stdio(&args.output);
     if !to_stdout {
-        check_directory(&args.output)?;
+        check_writable(&args.output)?;
     }
     if let Some(report) = &args.report {
-        check_directory(report)?;
+        check_writable(report)?;
     }
     let curve_format = match &args.curve_out {
         None => None,
@@ -60,7 +61,7 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
                     curve_out.display()
                 )));
             };
-            check_directory(curve_out)?;
+            check_writable(curve_out)?;
             if !formats::is_stdio(&args.input) {
                 io::ensure_distinct(&args.input, curve_out).map_err(Failure::usage)?;
             }
@@ -126,6 +127,7 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
     let input_name = input_name.display();
     let failed =
         |e| Failure::from_batten(&format!("{input_name}: method {} failed", method.name()), e);
+    let spinner = Spinner::start(format!("fairing with {}", method.name()));
     let faired = match &source {
         Source::Curve(curve) => fair::fair_curve(method.name(), curve, &options).map_err(failed)?,
         Source::Points(d) => fair::fair_with(method, &d.seq, &options).map_err(failed)?,
@@ -157,12 +159,29 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         ),
     }
     .map_err(Failure::failed)?;
-    formats::write_output(&args.output, &bytes)?;
-    if let Some(path) = &args.report {
-        write_report(path, &faired.report)?;
+    // One set, all or none: the report and the curve first, the points last, so that a
+    // faired file beside an older report cannot happen (see `io::write_atomic_set`). Points
+    // for standard output go there once the files are written.
+    let report = match &args.report {
+        Some(path) => Some((path, report_json(&faired.report)?.into_bytes())),
+        None => None,
+    };
+    let curve = match (&args.curve_out, curve_format) {
+        (Some(path), Some(format)) => {
+            Some((path, curve_bytes(path, format, &faired, closed, &origin)?))
+        }
+        _ => None,
+    };
+    let mut set: Vec<(&Path, &[u8])> = Vec::with_capacity(3);
+    set.extend(report.iter().map(|(p, b)| (p.as_path(), b.as_slice())));
+    set.extend(curve.iter().map(|(p, b)| (p.as_path(), b.as_slice())));
+    if !to_stdout {
+        set.push((&args.output, &bytes));
     }
-    if let (Some(path), Some(format)) = (&args.curve_out, curve_format) {
-        write_curve(path, format, &faired, closed, &origin)?;
+    io::write_atomic_set(&set).map_err(Failure::failed)?;
+    spinner.finish();
+    if to_stdout {
+        formats::write_output(&args.output, &bytes)?;
     }
 
     output::note(&summary(&faired.report, data));
@@ -183,21 +202,14 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
     }
 }
 
-/// A file can only be written into a directory that exists: say so before fairing.
-pub fn check_directory(path: &Path) -> Result<(), Failure> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    if dir.is_dir() {
-        Ok(())
-    } else {
-        Err(Failure::usage(anyhow!(
-            "{}: cannot write: directory {} does not exist",
-            path.display(),
-            dir.display()
-        )))
-    }
+/// Whether an output can be written (not a directory, in a directory that exists and takes
+/// new files), checked before any work so that "cannot write" is a usage error (exit 2)
+/// that leaves nothing behind.
+///
+/// # Errors
+/// [`Failure::usage`] naming the path and what stands in the way.
+pub fn check_writable(path: &Path) -> Result<(), Failure> {
+    io::check_writable(path).map_err(Failure::usage)
 }
 
 /// Whether two paths name the same file, as far as can be told before either exists.
@@ -212,16 +224,16 @@ enum Source {
     Curve(BSplineCurve),
 }
 
-/// Write the faired curve (JSON, DXF SPLINE, IGES 126 or SVG), atomically: the method's own
+/// The faired curve (JSON, DXF SPLINE, IGES 126 or SVG) as bytes: the method's own
 /// B-spline, or the analysis curve (the C² cubic through the faired points) converted
 /// exactly to B-spline form.
-fn write_curve(
+fn curve_bytes(
     path: &Path,
     format: Format,
     faired: &Faired,
     closed: bool,
     origin: &io::Origin,
-) -> Result<(), Failure> {
+) -> Result<Vec<u8>, Failure> {
     let converted;
     let curve = match &faired.curve {
         Some(c) => c,
@@ -236,24 +248,23 @@ fn write_curve(
             &converted
         }
     };
-    let bytes = match io::format_curve(format, path, curve, closed, origin) {
-        Ok(b) => b,
+    match io::format_curve(format, path, curve, closed, origin) {
+        Ok(b) => Ok(b),
         // SVG holds Béziers of degree 3 at most: the C² cubic through the faired points.
         Err(_) if format == Format::Svg => {
             io::format_points(format, path, &faired.points, closed, None, origin)
-                .map_err(Failure::failed)?
+                .map_err(Failure::failed)
         }
-        Err(e) => return Err(Failure::failed(e)),
-    };
-    io::write_atomic(path, &bytes).map_err(Failure::failed)
+        Err(e) => Err(Failure::failed(e)),
+    }
 }
 
-/// Write the report as pretty JSON, atomically.
-pub fn write_report(path: &Path, report: &FairReport) -> Result<(), Failure> {
+/// The report as pretty JSON.
+pub fn report_json(report: &FairReport) -> Result<String, Failure> {
     let mut json = serde_json::to_string_pretty(report)
         .map_err(|e| Failure::failed(anyhow!("cannot encode the report: {e}")))?;
     json.push('\n');
-    io::write_atomic(path, json.as_bytes()).map_err(Failure::failed)
+    Ok(json)
 }
 
 /// The one-line summary: method, status, iterations, largest displacement (and where),
@@ -275,9 +286,9 @@ fn summary(r: &FairReport, data: Option<&PointData>) -> String {
         Some(t) => format!("tolerance {} NOT met", format_f64(t)),
     };
     format!(
-        "{}: {status}, {} iterations, max displacement {}{at}, {tolerance}",
+        "{}: {status}, {}, max displacement {}{at}, {tolerance}",
         r.method,
-        r.iterations,
+        output::count(r.iterations, "iteration"),
         sig(r.max_displacement, DIGITS),
     )
 }

@@ -106,11 +106,35 @@ pub fn parse_tolerance(s: &str) -> Result<Tolerance, String> {
     if s.trim() == "auto" {
         return Ok(Tolerance::Auto);
     }
-    match s.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(Tolerance::Given(v)),
-        _ => Err(format!(
-            "'{s}' is not a positive distance in data units or 'auto'"
-        )),
+    let what = match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => return Ok(Tolerance::Given(v)),
+        Ok(v) if v < 0.0 => "is negative",
+        Ok(0.0) => "is zero",
+        Ok(_) => "is not finite",
+        Err(_) => "is not a number",
+    };
+    Err(format!(
+        "'{s}' {what}: give a positive distance in data units or 'auto'"
+    ))
+}
+
+/// `--max-iterations N` (clap value parser): a whole number from 1 to
+/// [`fair::MAX_ITERATIONS`].
+///
+/// # Errors
+/// A message naming the accepted range.
+pub fn parse_max_iterations(s: &str) -> Result<usize, String> {
+    parse_count(s, fair::MAX_ITERATIONS)
+}
+
+/// A whole number from 1 to `max`.
+///
+/// # Errors
+/// A message naming the accepted range.
+pub fn parse_count(s: &str, max: usize) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(n) if (1..=max).contains(&n) => Ok(n),
+        _ => Err(format!("'{s}' is not a whole number from 1 to {max}")),
     }
 }
 

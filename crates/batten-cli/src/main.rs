@@ -23,15 +23,17 @@ mod methods;
 mod output;
 mod plot;
 mod report;
+mod signals;
+mod spinner;
 mod surface_cmd;
 mod surface_plot;
 mod surface_report;
+mod usage;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use batten::fair::EndFix;
-use clap::error::ErrorKind;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 /// Fair planar curves: measure the curvature of the curve through a list of points, move the
@@ -113,8 +115,9 @@ struct FairArgs {
     #[arg(long, value_name = "WHAT", num_args = 0..=1, require_equals = true,
           default_missing_value = "position", value_parser = input::parse_end_fix)]
     fix_ends: Option<EndFix>,
-    /// Upper bound on the method's iterations (its own unit: sweeps, moves or passes)
-    #[arg(long, value_name = "N")]
+    /// Upper bound on the method's iterations (its own unit: sweeps, moves or passes), 1 to
+    /// 1000000
+    #[arg(long, value_name = "N", value_parser = input::parse_max_iterations)]
     max_iterations: Option<usize>,
     /// Write the fairing report (JSON) to this file
     #[arg(long, value_name = "R.json")]
@@ -173,23 +176,20 @@ struct CompareArgs {
 }
 
 fn main() -> ExitCode {
+    let argv: Vec<String> = std::env::args_os()
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
-        // A bad option value (`--tolerance -1`): one line, as for every other usage error;
-        // clap's own rendering adds a blank line and a "try '--help'" footer.
-        Err(e)
-            if matches!(
-                e.kind(),
-                ErrorKind::ValueValidation | ErrorKind::InvalidValue
-            ) =>
-        {
-            let text = e.render().to_string();
-            let first = text.lines().next().unwrap_or_default();
-            output::error_line(first.strip_prefix("error: ").unwrap_or(first));
-            return ExitCode::from(2);
-        }
-        Err(e) => e.exit(),
+        Err(e) => match usage::classify(e, &argv) {
+            usage::ClapOutcome::Print(e) => e.exit(),
+            usage::ClapOutcome::Usage(message) => {
+                output::error_line(&message);
+                return ExitCode::from(failure::EXIT_USAGE);
+            }
+        },
     };
+    signals::install();
     let result = match cli.command {
         Command::Analyze(a) => analyze::run(&a),
         Command::Fair(a) => fair_cmd::run(&a),

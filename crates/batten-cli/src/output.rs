@@ -51,6 +51,16 @@ pub fn sig(x: f64, digits: usize) -> String {
     }
 }
 
+/// A count and its noun, singular for one: `count(1, "file")` is `1 file`, `count(2, "file")`
+/// is `2 files`.
+pub fn count(n: usize, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
 /// A duration in seconds, in the unit that suits it (`412 µs`, `12.3 ms`, `1.25 s`).
 pub fn seconds(s: f64) -> String {
     if s < 1e-3 {
@@ -78,6 +88,13 @@ mod tests {
         assert_eq!(sig(1234567.0, 4), "1.235e6");
         assert_eq!(sig(f64::INFINITY, 4), "inf");
         assert_eq!(sig(f64::NAN, 4), "NaN");
+    }
+
+    #[test]
+    fn counts() {
+        assert_eq!(count(0, "file"), "0 files");
+        assert_eq!(count(1, "iteration"), "1 iteration");
+        assert_eq!(count(12, "point"), "12 points");
     }
 
     #[test]

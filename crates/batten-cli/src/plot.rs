@@ -167,17 +167,7 @@ pub(crate) fn check_output(
             extensions.join(" or .")
         )));
     }
-    let dir = match output.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    if !dir.is_dir() {
-        return Err(Failure::usage(anyhow!(
-            "{}: cannot write: directory {} does not exist",
-            output.display(),
-            dir.display()
-        )));
-    }
+    crate::fair_cmd::check_writable(output)?;
     for input in inputs {
         io::ensure_distinct(input, output).map_err(Failure::usage)?;
     }

@@ -15,7 +15,7 @@ use batten::surface::{
 use clap::Args;
 
 use crate::failure::{EXIT_FAILED, Failure};
-use crate::fair_cmd::{check_directory, same_path};
+use crate::fair_cmd::{check_writable, same_path};
 use crate::input;
 use crate::output::{self, sig};
 
@@ -161,7 +161,7 @@ pub fn fair(args: &FairSurfaceArgs) -> Result<ExitCode, Failure> {
                 out.display()
             )));
         }
-        check_directory(out)?;
+        check_writable(out)?;
         io::ensure_distinct(&args.input, out).map_err(Failure::usage)?;
     }
     if let Some(r) = &args.report

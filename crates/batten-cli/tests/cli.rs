@@ -647,7 +647,7 @@ fn tangents_are_carried_through() {
     );
     assert_usage_error(
         &batten(&["analyze", s(&bad)]),
-        &["bad-tangents.json: 1 tangents for 12 points"],
+        &["bad-tangents.json: 1 tangent for 12 points"],
     );
 }
 

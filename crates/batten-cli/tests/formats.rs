@@ -366,7 +366,7 @@ fn batch_fairs_every_dxf_entity_into_one_dxf() {
     );
     assert!(
         err.contains(
-            "batch: 1 files, 3 curves: 2 ok, 0 tolerance exceeded, 0 failed, 1 invalid input"
+            "batch: 1 file, 3 curves: 2 ok, 0 tolerance exceeded, 0 failed, 1 invalid input"
         ),
         "{err}"
     );

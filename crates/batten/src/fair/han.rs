@@ -120,6 +120,10 @@ pub const DEFAULT_ALPHA_FACTOR: f64 = 0.2;
 pub const DEFAULT_FINE_RUN3: bool = true;
 /// Default number of points shared by consecutive segments, k \[PAPER\].
 pub const DEFAULT_OVERLAP: usize = 5;
+
+/// Largest `overlap` accepted: an overlap beyond a segment's length changes nothing, and this
+/// is more points than any segment holds in practice.
+pub const MAX_OVERLAP: usize = 1_000_000;
 /// Default number of pipeline passes (partition, fair, blend) \[CHOICE\].
 pub const DEFAULT_PASSES: usize = 3;
 /// The paper's turning threshold of the partition, π \[PAPER\] (`--set max_turn=pi`).
@@ -1709,7 +1713,7 @@ static PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "overlap",
         default: "5",
-        doc: "points shared by consecutive function segments (k), ≥ 1",
+        doc: "points shared by consecutive function segments (k), 1 to 1000000",
     },
     ParamSpec {
         name: "passes",
@@ -1757,7 +1761,7 @@ impl HanParams {
         segment.validate()?;
         Ok(HanParams {
             segment,
-            overlap: o.param_usize_in("overlap", DEFAULT_OVERLAP, 1, usize::MAX / 4)?,
+            overlap: o.param_usize_in("overlap", DEFAULT_OVERLAP, 1, MAX_OVERLAP)?,
             passes: o.param_usize_in("passes", DEFAULT_PASSES, 1, 10_000)?,
             max_turn: param_angle(o, "max_turn", DEFAULT_MAX_TURN)?,
             iterations: o.iterations_or(DEFAULT_ITERATIONS),

@@ -90,16 +90,16 @@ impl FromStr for EndFix {
 /// coordinate.
 pub const AUTO_TOLERANCE_K: f64 = 3.0;
 
+/// Largest iteration limit accepted ([`FairOptions::max_iterations`]). Every method's
+/// iteration costs at least one pass over its curve, and the per-iteration history of the
+/// report grows with the count: at this bound a 30-point `kjellander` run takes about 6 s
+/// and 70 MB, and larger limits only let a run go on for minutes and gigabytes.
+pub const MAX_ITERATIONS: usize = 1_000_000;
+
 /// Options common to every fairing method, plus the method's own parameters.
 ///
 /// Built with [`FairOptions::default`] and the `with_*` methods; the defaults are in
 /// [`FairOptions::DEFAULT`].
-/// The largest `max_iterations` accepted. A million single-point moves of the Kjellander
-/// family take about a second; beyond that a run is not converging but walking through
-/// rounding (`threshold=0` with 2⁶⁴ iterations ran for minutes and took a gigabyte for its
-/// move log).
-pub const MAX_ITERATIONS: usize = 1_000_000;
-
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct FairOptions {
@@ -119,8 +119,9 @@ pub struct FairOptions {
     ///
     /// Default value: [`EndFix::Free`].
     pub fix_ends: EndFix,
-    /// Upper bound on the method's iterations (its unit: sweeps, moves or passes), at most
-    /// [`MAX_ITERATIONS`]. `None`: the method's own default.
+    /// Upper bound on the method's iterations (its unit: sweeps, moves or passes), from 0 (the
+    /// method's starting state, e.g. `kuragano`'s design curve) to [`MAX_ITERATIONS`]. `None`:
+    /// the method's own default. The CLI takes 1 and up.
     ///
     /// Default value: `None`.
     pub max_iterations: Option<usize>,
@@ -198,25 +199,26 @@ impl FairOptions {
         self
     }
 
-    /// Check the common options: a tolerance must be finite and positive.
+    /// Check the common options: a tolerance must be finite and positive, an iteration limit
+    /// at most [`MAX_ITERATIONS`].
     ///
     /// # Errors
     /// [`Error::InvalidParameter`].
     pub fn validate(&self) -> Result<()> {
-        if let Some(n) = self.max_iterations
-            && n > MAX_ITERATIONS
-        {
-            return Err(Error::InvalidParameter {
-                name: "max_iterations".into(),
-                reason: format!("{n} is above the limit {MAX_ITERATIONS}"),
-            });
-        }
         if let Some(t) = self.tolerance
             && !(t.is_finite() && t > 0.0)
         {
             return Err(Error::InvalidParameter {
                 name: "tolerance".into(),
                 reason: format!("must be a positive finite number, got {t}"),
+            });
+        }
+        if let Some(n) = self.max_iterations
+            && n > MAX_ITERATIONS
+        {
+            return Err(Error::InvalidParameter {
+                name: "max_iterations".into(),
+                reason: format!("{n} is outside [0, {MAX_ITERATIONS}]"),
             });
         }
         Ok(())
@@ -253,7 +255,7 @@ impl FairOptions {
         if !(lo..=hi).contains(&v) {
             return Err(Error::InvalidParameter {
                 name: key.into(),
-                reason: format!("{v} is outside [{lo}, {hi}]"),
+                reason: range_reason(v, lo, hi),
             });
         }
         Ok(v)
@@ -307,6 +309,19 @@ impl FairOptions {
     }
 }
 
+/// Why `v` is not in `[lo, hi]`, in words short enough for one line: the open ends of the
+/// `f64` range (`f64::MIN_POSITIVE`, `f64::MAX`) are said as "positive" and "at least", not
+/// printed as 300-digit numbers; other bounds in their shortest exact form.
+fn range_reason(v: f64, lo: f64, hi: f64) -> String {
+    let num = crate::io::format_f64;
+    match (lo == f64::MIN_POSITIVE, hi == f64::MAX) {
+        (true, true) => format!("must be a positive number, got {}", num(v)),
+        (false, true) => format!("must be at least {}, got {}", num(lo), num(v)),
+        (true, false) => format!("must be positive and at most {}, got {}", num(hi), num(v)),
+        (false, false) => format!("{} is outside [{}, {}]", num(v), num(lo), num(hi)),
+    }
+}
+
 impl Default for FairOptions {
     fn default() -> FairOptions {
         FairOptions::DEFAULT
@@ -322,4 +337,61 @@ pub struct ParamSpec {
     pub default: &'static str,
     /// One line on what it does.
     pub doc: &'static str,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn reason(o: &FairOptions) -> String {
+        match o.validate() {
+            Err(Error::InvalidParameter { reason, .. }) => reason,
+            other => format!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn iteration_limit_is_bounded_both_ways() {
+        let o = FairOptions::default();
+        assert!(o.clone().with_max_iterations(0).validate().is_ok());
+        assert!(o.clone().with_max_iterations(1).validate().is_ok());
+        assert!(
+            o.clone()
+                .with_max_iterations(MAX_ITERATIONS)
+                .validate()
+                .is_ok()
+        );
+        assert_eq!(
+            reason(&o.clone().with_max_iterations(MAX_ITERATIONS + 1)),
+            "1000001 is outside [0, 1000000]"
+        );
+        assert_eq!(
+            reason(&o.with_max_iterations(usize::MAX)),
+            "18446744073709551615 is outside [0, 1000000]"
+        );
+    }
+
+    #[test]
+    fn range_reasons_stay_short() {
+        let o = FairOptions::default().with_param("g", 0);
+        let e = o.param_f64_in("g", 1.0, f64::MIN_POSITIVE, f64::MAX);
+        assert!(
+            matches!(&e, Err(Error::InvalidParameter { reason, .. })
+                if reason == "must be a positive number, got 0"),
+            "{e:?}"
+        );
+        assert_eq!(
+            range_reason(-1.0, 0.5, f64::MAX),
+            "must be at least 0.5, got -1"
+        );
+        assert_eq!(
+            range_reason(3.0, f64::MIN_POSITIVE, 2.0),
+            "must be positive and at most 2, got 3"
+        );
+        assert_eq!(range_reason(2.0, 0.0, 1.0), "2 is outside [0, 1]");
+        assert_eq!(
+            range_reason(1e300, -1e-7, 1.0),
+            "1e300 is outside [-1e-7, 1]"
+        );
+    }
 }

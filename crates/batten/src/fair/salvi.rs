@@ -103,7 +103,8 @@ pub const MIN_SAMPLES: usize = 4;
 /// Most samples accepted when given: every iteration evaluates its simplex over the samples
 /// of one support, so a run costs about 1 ms per 1000 samples per iteration (20 000 samples
 /// and the default 1000 iterations: about 20 s; 10⁶ ran for more than 5 minutes). The
-/// automatic count, 8 per knot span, is not capped.
+/// automatic count, 8 per knot span, is not capped. Also the bound of `half_width` and
+/// `target_coefficients`, which are counts of samples.
 pub const MAX_SAMPLES: usize = 20_000;
 
 /// The moving-average half-width is `⌊N / HALF_WIDTH_DIVISOR⌋` (spec §3 step 3.2).
@@ -828,7 +829,7 @@ static PARAMS: [ParamSpec; 11] = [
     ParamSpec {
         name: "half_width",
         default: "auto",
-        doc: "moving-average half-width in samples (auto: N/20)",
+        doc: "moving-average half-width in samples (auto: N/20; at most 20000)",
     },
     ParamSpec {
         name: "passes",
@@ -838,7 +839,7 @@ static PARAMS: [ParamSpec; 11] = [
     ParamSpec {
         name: "target_coefficients",
         default: "auto",
-        doc: "coefficients of the bspline target fit (auto: max(4, N/20))",
+        doc: "coefficients of the bspline target fit (auto: max(4, N/20); at most 20000)",
     },
     ParamSpec {
         name: "pin_ends",
@@ -853,7 +854,7 @@ static PARAMS: [ParamSpec; 11] = [
     ParamSpec {
         name: "window",
         default: "50",
-        doc: "stop when the measure improved < 0.1% over this many iterations (0: never)",
+        doc: "stop when the measure improved < 0.1% over this many iterations (0: never; at most 1000000)",
     },
     FIT_PARAMS[0],
     FIT_PARAMS[1],
@@ -977,7 +978,7 @@ fn salvi_params(
     let auto_usize = |key: &str, lo: usize| -> Result<Option<usize>> {
         match options.params.get(key).map(|s| s.trim()) {
             None | Some("auto") => Ok(None),
-            Some(_) => options.param_usize_in(key, lo, lo, usize::MAX).map(Some),
+            Some(_) => options.param_usize_in(key, lo, lo, MAX_SAMPLES).map(Some),
         }
     };
     let coefficients = auto_usize("target_coefficients", MIN_TARGET_COEFFICIENTS)?;
@@ -995,7 +996,7 @@ fn salvi_params(
         tolerance,
         tabu_length: options.param_usize_in("tabu", DEFAULT_TABU_LENGTH, 0, 1000)?,
         max_iterations,
-        window: options.param_usize_in("window", DEFAULT_WINDOW, 0, usize::MAX)?,
+        window: options.param_usize_in("window", DEFAULT_WINDOW, 0, super::MAX_ITERATIONS)?,
         min_rel_improvement: WINDOW_MIN_REL_IMPROVEMENT,
         free_ends,
         held_ends: options.fix_ends.held().max(1),

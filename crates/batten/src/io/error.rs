@@ -86,8 +86,42 @@ pub enum IoError {
         /// The 1-based line of the point.
         line: usize,
     },
+    /// A coordinate beyond [`super::MAX_COORDINATE`] in magnitude.
+    #[error(
+        "{}:{line}: coordinate {} is beyond ±1e300, the largest magnitude batten takes \
+         (rescale the data)",
+        path.display(),
+        super::format_f64(*value)
+    )]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// The 1-based line of the point.
+        line: usize,
+        /// The coordinate.
+        value: f64,
+    },
+    /// A point nearly duplicates its neighbour: closer than
+    /// [`crate::geom::NEAR_DUPLICATE_REL`] times the larger side of the bounding box (the
+    /// library's [`crate::Error::NearDuplicate`], with lines).
+    #[error(
+        "{}:{line}: point nearly duplicates the one on line {other} ({relative:.1e} of the \
+         curve's size apart, under {limit:e}); remove one of them",
+        path.display(),
+        limit = crate::geom::NEAR_DUPLICATE_REL
+    )]
+    NearDuplicate {
+        /// The file.
+        path: PathBuf,
+        /// The 1-based line of the later point.
+        line: usize,
+        /// The 1-based line of the point it nearly repeats.
+        other: usize,
+        /// Their distance over the larger side of the bounding box.
+        relative: f64,
+    },
     /// Fewer points than batten needs ([`crate::PointSeq::MIN_POINTS`]).
-    #[error("{}: {got} points, at least {needed} needed", path.display())]
+    #[error("{}: {got} point{}, at least {needed} needed", path.display(), plural(*got))]
     TooFewPoints {
         /// The file.
         path: PathBuf,
@@ -159,7 +193,12 @@ pub enum IoError {
         message: String,
     },
     /// A JSON point list whose `tangents` array has a different length than `points`.
-    #[error("{}: {got} tangents for {expected} points", path.display())]
+    #[error(
+        "{}: {got} tangent{} for {expected} point{}",
+        path.display(),
+        plural(*got),
+        plural(*expected)
+    )]
     TangentCount {
         /// The file.
         path: PathBuf,
@@ -212,6 +251,11 @@ pub enum IoError {
         /// The output path as given.
         output: PathBuf,
     },
+}
+
+/// The plural ending of a count: "1 point", "2 points".
+fn plural(n: usize) -> &'static str {
+    if n == 1 { "" } else { "s" }
 }
 
 /// A place in a file, for [`IoError::Format`]: displayed as nothing, `:LINE` or

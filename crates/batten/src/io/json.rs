@@ -16,7 +16,7 @@ use serde::Deserialize;
 
 use super::IoError;
 use crate::geom::{Point, Vec2};
-use crate::spline::BSplineCurve;
+use crate::spline::{BSplineCurve, KnotVector};
 
 /// Keys that mark a B-spline object.
 const CURVE_KEYS: [&str; 3] = ["degree", "knots", "control_points"];
@@ -31,6 +31,18 @@ struct PointsJson {
     closed: bool,
     #[serde(default)]
     tangents: Option<Vec<Vec<f64>>>,
+}
+
+/// A B-spline as read, before validation: unknown keys refused, control points of any
+/// length so that a 3-D point is named with its line (see [`PointsJson`]).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CurveJson {
+    degree: usize,
+    knots: Vec<f64>,
+    control_points: Vec<Vec<f64>>,
+    #[serde(default)]
+    weights: Option<Vec<f64>>,
 }
 
 /// A parsed JSON point list, not yet validated as a [`crate::PointSeq`].
@@ -171,7 +183,25 @@ pub(crate) fn parse_curve(bytes: &[u8], path: &Path) -> Result<BSplineCurve, IoE
             path: path.to_path_buf(),
         });
     }
-    serde_json::from_str(text).map_err(|e| json_error(path, &e))
+    let raw: CurveJson = serde_json::from_str(text).map_err(|e| json_error(path, &e))?;
+    let lines = lines_or_first(
+        element_lines(text, "control_points"),
+        raw.control_points.len(),
+    );
+    let control_points = pairs(raw.control_points, &lines, path)?
+        .into_iter()
+        .map(|(x, y)| Point::new(x, y))
+        .collect();
+    let knots = KnotVector::try_new(raw.knots).map_err(|source| IoError::Invalid {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    BSplineCurve::try_new(raw.degree, knots, control_points, raw.weights).map_err(|source| {
+        IoError::Invalid {
+            path: path.to_path_buf(),
+            source,
+        }
+    })
 }
 
 /// One number as serde_json writes it: shortest round-trip digits (`1.0`, `1e300`, `-0.0`).

@@ -10,6 +10,8 @@
 //! - [`read_curve_json`] reads a B-spline curve; [`read_points`] refuses one.
 //! - [`write_points`] writes atomically (a temporary file beside the target, renamed over it)
 //!   and numbers in their shortest exact form: what is written reads back bit for bit.
+//!   [`write_atomic_set`] writes several files all or none; [`check_writable`] tells before
+//!   any work whether an output can be created; [`remove_temporaries`] cleans up on a signal.
 //! - [`ensure_distinct`] refuses an output path that is the input file.
 //!
 //! - [`parse_input`] / [`read_input`] read any format from bytes (standard input) or a file,
@@ -65,21 +67,23 @@
 //! # }
 //! ```
 
+mod atomic;
 mod dxf;
 mod error;
 mod iges;
 mod json;
+mod limits;
 mod surface;
 mod svg;
 mod text;
 
 use std::fs;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
+pub use atomic::{check_writable, remove_temporaries, write_atomic, write_atomic_set};
 pub use dxf::{DxfCurve, DxfDrawing, DxfGeometry};
 pub use error::{IoError, Location};
+pub use limits::MAX_COORDINATE;
 pub use surface::{format_surface, parse_surface, read_surface_json, write_surface_json};
 pub use text::format_f64;
 
@@ -191,7 +195,9 @@ pub fn read_points(path: &Path, options: &ReadOptions) -> Result<PointData, IoEr
 /// One error naming the line, for the first problem met: [`IoError::NotUtf8`],
 /// [`IoError::FieldCount`], [`IoError::NotANumber`], [`IoError::NonFinite`], [`IoError::Json`],
 /// [`IoError::CurveNotPoints`]; then, for the whole list, [`IoError::Empty`],
-/// [`IoError::TooFewPoints`], [`IoError::DuplicatePoint`], [`IoError::RepeatsFirst`],
+/// [`IoError::TooLarge`] (beyond [`MAX_COORDINATE`]), [`IoError::TooFewPoints`],
+/// [`IoError::DuplicatePoint`], [`IoError::RepeatsFirst`], [`IoError::NearDuplicate`]
+/// (closer than [`crate::geom::NEAR_DUPLICATE_REL`] of the bounding box's larger side),
 /// [`IoError::TangentCount`].
 pub fn parse_points(
     bytes: &[u8],
@@ -254,7 +260,12 @@ fn validate(
         });
     }
     let line = |i: usize| lines.get(i).copied().unwrap_or(1);
-    match PointSeq::new(points.clone(), closed) {
+    limits::check_magnitudes(path, &points, lines)?;
+    // What tells a repeated neighbour from a closed curve's repeated first point, noted before
+    // the points move into the sequence (rather than validating a copy: 16 MB at 10⁶ points).
+    let n = points.len();
+    let last_repeats_previous = n >= 2 && points[n - 1] == points[n - 2];
+    match PointSeq::new(points, closed) {
         Ok(seq) => Ok(seq),
         Err(Error::TooFewPoints { needed, got }) => Err(IoError::TooFewPoints {
             path: path.to_path_buf(),
@@ -266,7 +277,7 @@ fn validate(
             line: line(index),
         }),
         Err(Error::DuplicatePoint { index })
-            if index > 0 && points.get(index - 1) == points.get(index) =>
+            if index > 0 && (index + 1 < n || !closed || last_repeats_previous) =>
         {
             Err(IoError::DuplicatePoint {
                 path: path.to_path_buf(),
@@ -279,6 +290,20 @@ fn validate(
             line: line(index),
             first: line(0),
         }),
+        Err(Error::NearDuplicate {
+            index,
+            previous,
+            relative,
+        }) => {
+            // The closing chord of a closed curve comes as (first, last): name the later line.
+            let (a, b) = (line(index), line(previous));
+            Err(IoError::NearDuplicate {
+                path: path.to_path_buf(),
+                line: a.max(b),
+                other: a.min(b),
+                relative,
+            })
+        }
         Err(source) => Err(IoError::Invalid {
             path: path.to_path_buf(),
             source,
@@ -300,6 +325,14 @@ pub fn read_curve_json(path: &Path) -> Result<BSplineCurve, IoError> {
     }
     let bytes = read_bytes(path)?;
     json::parse_curve(&bytes, path)
+}
+
+/// Parse a B-spline curve held in memory as JSON; `path` names it in messages.
+///
+/// # Errors
+/// As [`read_curve_json`], less the reading.
+pub fn parse_curve_json(bytes: &[u8], path: &Path) -> Result<BSplineCurve, IoError> {
+    json::parse_curve(bytes, path)
 }
 
 fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
@@ -324,17 +357,23 @@ pub fn write_points(
     closed: bool,
     tangents: Option<&[Vec2]>,
 ) -> Result<(), IoError> {
-    let format = Format::from_path(path)?;
-    let bad_point = points.iter().position(|p| !p.is_finite());
-    let bad_tangent = tangents.and_then(|t| t.iter().position(|v| !v.is_finite()));
-    if let Some(index) = bad_point.or(bad_tangent) {
-        return Err(IoError::NonFiniteOutput {
-            path: path.to_path_buf(),
-            index,
-        });
-    }
-    let contents = format_points(format, path, points, closed, tangents, &Origin::default())?;
+    let contents = encode_points(path, points, closed, tangents)?;
     write_atomic(path, &contents)
+}
+
+/// The text [`write_points`] would write to `path` (format by extension), to write it later
+/// with other files as one set ([`write_atomic_set`]).
+///
+/// # Errors
+/// [`IoError::UnknownFormat`], [`IoError::NonFiniteOutput`].
+pub fn encode_points(
+    path: &Path,
+    points: &[Point],
+    closed: bool,
+    tangents: Option<&[Vec2]>,
+) -> Result<Vec<u8>, IoError> {
+    let format = Format::from_path(path)?;
+    format_points(format, path, points, closed, tangents, &Origin::default())
 }
 
 /// Which curve to take from a file that can hold several (DXF, IGES, SVG), and how.
@@ -598,68 +637,6 @@ pub fn format_curve(
     })
 }
 
-/// Distinguishes temporary files of concurrent writes from one process.
-static TEMP_COUNTER: AtomicUsize = AtomicUsize::new(0);
-
-/// How many temporary names to try before giving up.
-const TEMP_ATTEMPTS: usize = 64;
-
-/// Write `contents` to `path` atomically: into a new temporary file in the same directory
-/// (`.NAME.PID.N.tmp`), flushed to disk, then renamed over `path`. Readers see the old file
-/// or the new one, never a partial one; on failure the temporary file is removed and `path`
-/// is untouched. The new file has default permissions; a symbolic link at `path` is
-/// replaced by the file, not followed.
-///
-/// # Errors
-/// [`IoError::Write`].
-pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), IoError> {
-    let write_err = |source| IoError::Write {
-        path: path.to_path_buf(),
-        source,
-    };
-    let name = path.file_name().ok_or_else(|| {
-        write_err(std::io::Error::new(
-            std::io::ErrorKind::InvalidInput,
-            "not a file name",
-        ))
-    })?;
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut attempt = 0;
-    let (tmp, mut file) = loop {
-        let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
-        let mut tmp_name = std::ffi::OsString::from(".");
-        tmp_name.push(name);
-        tmp_name.push(format!(".{}.{n}.tmp", std::process::id()));
-        let tmp = dir.join(tmp_name);
-        match fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&tmp)
-        {
-            Ok(f) => break (tmp, f),
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && attempt < TEMP_ATTEMPTS => {
-                attempt += 1;
-            }
-            Err(e) => return Err(write_err(e)),
-        }
-    };
-    let result = file
-        .write_all(contents)
-        .and_then(|()| file.sync_all())
-        .and_then(|()| {
-            drop(file);
-            fs::rename(&tmp, path)
-        });
-    result.map_err(|e| {
-        // Best effort: the temporary file may already be gone.
-        let _ = fs::remove_file(&tmp);
-        write_err(e)
-    })
-}
-
 /// Refuse to write `output` when it is the file `input` (the same file after resolving `.`,
 /// `..` and symbolic links, or, on Unix, another hard link to it).
 ///
@@ -728,7 +705,9 @@ mod tests {
     }
 
     fn tempdir() -> PathBuf {
-        let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        static DIRS: AtomicUsize = AtomicUsize::new(0);
+        let n = DIRS.fetch_add(1, Ordering::Relaxed);
         let d = std::env::temp_dir().join(format!("batten-io-test-{}-{n}", std::process::id()));
         fs::create_dir_all(&d).unwrap();
         d
@@ -829,7 +808,7 @@ mod tests {
         )
         .unwrap_err()
         .to_string();
-        assert_eq!(e, "d.json: 1 tangents for 4 points");
+        assert_eq!(e, "d.json: 1 tangent for 4 points");
         let e = parse_points(
             b"{\"points\": []}",
             Format::Json,
@@ -848,7 +827,7 @@ mod tests {
             Point::new(-0.0, 1e-300),
             Point::new(1e300, 5e-324),
             Point::new(0.1, -1.0 / 3.0),
-            Point::new(f64::MIN_POSITIVE / 3.0, f64::MAX),
+            Point::new(f64::MIN_POSITIVE / 3.0, -MAX_COORDINATE),
             Point::new(std::f64::consts::PI, -1e-7),
         ];
         let tangents = vec![Vec2::new(0.6, 0.8); 5];
@@ -866,6 +845,7 @@ mod tests {
         }
         let text = fs::read_to_string(dir.join("p.csv")).unwrap();
         assert!(text.starts_with("x,y\n-0,1e-300\n1e300,5e-324\n"), "{text}");
+        // Closed, the last point must not nearly repeat the first (relative to the extent).
         let path = dir.join("closed.json");
         // Closed, these points would be refused: the closing chord, π, is 10⁻³⁰⁸ of the size.
         let square =

@@ -45,6 +45,9 @@ mod energy;
 mod params;
 mod solver;
 
+#[cfg(test)]
+mod reference_tests;
+
 use serde_json::{Map, Value};
 
 use crate::error::{Error, Result};

@@ -1,0 +1,31 @@
+//! The CSV/whitespace text reader on arbitrary bytes: never a panic; a point list it accepts
+//! is finite, within the coordinate limit, free of (near-)duplicate neighbours, and has one
+//! line number per point, increasing.
+#![no_main]
+
+use std::path::Path;
+
+use batten::io::{self, Format, ReadOptions};
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    for closed in [false, true] {
+        let options = ReadOptions::default().with_closed(closed);
+        if let Ok(d) = io::parse_points(data, Format::Text, Path::new("f.csv"), &options) {
+            let pts = d.seq.points();
+            assert!(pts.len() >= batten::PointSeq::MIN_POINTS);
+            assert_eq!(d.lines.len(), pts.len());
+            assert!(d.lines.windows(2).all(|w| w[0] < w[1]));
+            assert!(
+                pts.iter()
+                    .all(|p| p.x.abs() <= io::MAX_COORDINATE && p.y.abs() <= io::MAX_COORDINATE)
+            );
+            // What is read writes back and reads back bit for bit.
+            let text = io::encode_points(Path::new("f.csv"), pts, false, None).unwrap();
+            let back =
+                io::parse_points(&text, Format::Text, Path::new("f.csv"), &options)
+                    .unwrap();
+            assert_eq!(back.seq.points(), pts);
+        }
+    }
+});
