@@ -348,6 +348,3 @@ fn into_band<const D: usize>(pts: &[[f64; D]], r: &[f64], tolerance: f64) -> Vec
         })
         .collect()
 }
-
-#[cfg(test)]
-mod reference_tests;
