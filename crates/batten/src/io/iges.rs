@@ -80,7 +80,7 @@ struct Dir {
 /// Split the file into records by section.
 fn records(bytes: &[u8], path: &Path) -> Result<[Vec<Rec>; 5], IoError> {
     let mut secs: [Vec<Rec>; 5] = Default::default();
-    let lines: Vec<&[u8]> = if !bytes.contains(&b'\n') && bytes.len() % RECORD == 0 {
+    let lines: Vec<&[u8]> = if !bytes.contains(&b'\n') && bytes.len().is_multiple_of(RECORD) {
         bytes.chunks(RECORD).collect()
     } else {
         bytes.split(|&b| b == b'\n').collect()

@@ -28,7 +28,7 @@ pub(crate) fn push_num(buf: &mut String, x: f64) {
     let a = tenths.unsigned_abs();
     // Writing to a String cannot fail.
     let _ = write!(buf, "{}", a / 10);
-    if a % 10 != 0 {
+    if !a.is_multiple_of(10) {
         let _ = write!(buf, ".{}", a % 10);
     }
 }

@@ -250,11 +250,11 @@ fn from_path(
                 lines.push(line);
             }
         }
-        if !sp.closed {
-            if let Some(last) = sp.segs.last() {
-                points.push(last.end());
-                lines.push(pos(last.at()).0);
-            }
+        if !sp.closed
+            && let Some(last) = sp.segs.last()
+        {
+            points.push(last.end());
+            lines.push(pos(last.at()).0);
         }
         return Ok(Raw::Points {
             points,
