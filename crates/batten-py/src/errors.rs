@@ -29,6 +29,7 @@ fn is_usage(e: &batten::Error) -> bool {
             | E::TooFewPoints { .. }
             | E::NonFinite { .. }
             | E::DuplicatePoint { .. }
+            | E::NearDuplicate { .. }
     )
 }
 

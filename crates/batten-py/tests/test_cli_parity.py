@@ -126,12 +126,12 @@ def test_option_errors_carry_the_cli_message(cli, tmp_path: Path, kwargs, flags)
     assert proc.stderr.strip() == f"error: {e.value}"
 
 
-def test_a_failed_fair_carries_the_cli_message(cli, tmp_path: Path):
+def test_huge_coordinates_match_the_cli(cli, tmp_path: Path):
     x = np.arange(20.0)
-    huge = np.column_stack([x * 1e300, np.sin(x) * 1e300])
+    huge = np.column_stack([x * 1e200, np.sin(x) * 1e200])
     src = write_csv(tmp_path / "in.csv", huge)
-    proc = run_cli(cli, "fair", str(src), "-o", str(tmp_path / "o.csv"), "--method", "mst")
-    assert proc.returncode == 1
-    with pytest.raises(batten.FairError) as e:
-        batten.fair(huge, method="mst")
-    assert proc.stderr.strip() == f"error: {src}: {e.value}"
+    out = tmp_path / "o.csv"
+    proc = run_cli(cli, "fair", str(src), "-o", str(out), "--method", "mst")
+    assert proc.returncode == 0, proc.stderr
+    r = batten.fair(huge, method="mst")
+    assert np.array_equal(r.points, np.loadtxt(out, delimiter=",", skiprows=1))
