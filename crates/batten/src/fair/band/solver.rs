@@ -15,14 +15,16 @@
 //! digits the stopping rule needs.
 //!
 //! This is a convex quadratically constrained program with the same feasible set as the second-order
-//! cones `|q_i − p_i| ≤ D`. It is solved by an infeasible primal-dual interior-point method
+//! cones `|q_i − p_i| ≤ D`. It is solved by a feasible primal-dual interior-point method
 //! with Mehrotra's predictor-corrector (Nocedal & Wright, *Numerical Optimization*, §14.2 and
 //! §19.3): with slacks `σ_i` (`h_i + σ_i = 0`, `h_i = |y_i − c_i|² − 1`) and multipliers
 //! `λ_i`, each iteration linearises the conditions `∇f + Σ λ_i ∇h_i = 0`, `h + σ = 0`,
 //! `λ_i σ_i = μ`, takes an affine predictor step (target `μ = 0`), picks the centring
 //! `(μ_aff / μ)³` from how far it got, and takes the corrected step, 99 % of the way to the
-//! boundary of `λ, σ > 0`. Keeping the slacks as variables (rather than recomputing `−h`)
-//! keeps the digits of the points on the band's edge, where `h` would cancel.
+//! boundary of `λ, σ > 0` and shortened until every point stays strictly inside the band.
+//! Every iterate is feasible, so the slack is recomputed as `σ_i = −h_i` and the constraint
+//! residual `h + σ` is zero; the corrector's constraint target carries the second-order term
+//! `|Δy_i|²` of the predictor instead (see [`direction`]).
 //!
 //! Eliminating `Δλ` and `Δσ` leaves one symmetric positive definite system per direction
 //! (see [`direction`]), `(2A + Σ_i [2λ_i I + (4λ_i / σ_i) r_i r_iᵀ]) Δy = …`,
@@ -47,9 +49,6 @@ const BACKTRACK: f64 = 0.5;
 const MAX_BACKTRACKS: usize = 60;
 /// Consecutive steps shorter than [`MIN_STEP`] before the run stops.
 const MAX_STALLS: usize = 3;
-/// The constraint residual `|r|² − 1 + σ` (in tolerances²) accepted at the end; the result is
-/// put into the band exactly afterwards.
-const PRIMAL_TOL: f64 = 1e-9;
 /// The objective below which the gap is measured absolutely, per free point (the problem is in
 /// units of the tolerance and the spacing, so this is scale-free).
 const OBJECTIVE_FLOOR: f64 = 1e-12;
@@ -348,9 +347,8 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
     let mut ay = vec![0.0; dim];
     let mut grad = vec![0.0; dim];
     let mut rd = vec![0.0; dim];
-    let mut rp = vec![0.0; n];
     let mut rc = vec![0.0; n];
-    let mut rp_corr = vec![0.0; n];
+    let mut rp = vec![0.0; n];
     let mut dy = vec![0.0; dim];
     let mut dlam = vec![0.0; n];
     let mut dsig = vec![0.0; n];
@@ -378,7 +376,6 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
         let mut gap = 0.0;
         for i in 0..n {
             if held[i] {
-                rp[i] = 0.0;
                 for a in 0..D {
                     rd[i * D + a] = 0.0;
                 }
@@ -387,7 +384,6 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
             // Every iterate is strictly inside the band (the step below keeps it there), so
             // the slack is the constraint's own value and the primal residual is zero.
             st.sig[i] = -constraint(&st.off[i * D..(i + 1) * D]);
-            rp[i] = 0.0;
             gap += st.lam[i] * st.sig[i];
             for a in 0..D {
                 let k = i * D + a;
@@ -397,7 +393,6 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
         let f = objective(&st.y, &ay);
         let scale = f.abs().max(OBJECTIVE_FLOOR * free as f64);
         last_gap = gap / scale;
-        let primal_ok = norm_inf(&rp) <= PRIMAL_TOL;
         // The dual residual is measured against the size of the terms that make it up
         // (`|A| |y|` bounds the rounding of `A y`), so that its rounding floor counts as zero.
         let terms = (2.0 * a_abs * norm_inf(&st.y))
@@ -405,7 +400,7 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
             .max(norm_inf(&grad))
             .max(GRADIENT_FLOOR);
         let dual_ok = norm_inf(&rd) <= DUAL_RESIDUAL_REL * terms;
-        if gap <= GAP_REL * scale && primal_ok && dual_ok {
+        if gap <= GAP_REL * scale && dual_ok {
             converged = true;
             break;
         }
@@ -437,10 +432,11 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
             break;
         }
 
-        // Predictor (affine scaling): complementarity target 0.
+        // Predictor (affine scaling): complementarity target 0, constraint target 0.
         for i in 0..n {
             rc[i] = if held[i] { 0.0 } else { st.lam[i] * st.sig[i] };
         }
+        rp.fill(0.0);
         if direction(
             p, &newton, &blocks, &st, &rd, &rp, &rc, &mut dy, &mut dlam, &mut dsig, &mut rhs,
             &mut work,
@@ -465,15 +461,15 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
         for i in 0..n {
             if held[i] {
                 rc[i] = 0.0;
-                rp_corr[i] = 0.0;
+                rp[i] = 0.0;
                 continue;
             }
             rc[i] = st.lam[i] * st.sig[i] + dlam[i] * dsig[i] - centring * mu;
             let slide: f64 = (0..D).map(|a| dy[i * D + a] * dy[i * D + a]).sum();
-            rp_corr[i] = rp[i] + alpha_aff * slide;
+            rp[i] = alpha_aff * slide;
         }
         if direction(
-            p, &newton, &blocks, &st, &rd, &rp_corr, &rc, &mut dy, &mut dlam, &mut dsig, &mut rhs,
+            p, &newton, &blocks, &st, &rd, &rp, &rc, &mut dy, &mut dlam, &mut dsig, &mut rhs,
             &mut work,
         )
         .is_err()
