@@ -54,18 +54,82 @@ fn removes_the_wiggles_of_a_noisy_sine_within_the_tolerance() {
     assert!(r.after.inflections <= 1, "{}", r.after.inflections);
     let solver = r.solver.as_ref().expect("band reports its solver");
     assert!(solver.iterations > 0 && solver.duality_gap <= 1e-6);
+    // Without the debiasing stage the fairest curve in the band touches the band's edge.
+    let pure = fair::fair(
+        "band",
+        &input,
+        &FairOptions::default()
+            .with_tolerance(0.05)
+            .with_param("fit", 0),
+    )
+    .unwrap();
+    let solver = pure
+        .report
+        .solver
+        .as_ref()
+        .expect("band reports its solver");
     assert!(solver.points_on_band_edge > 0);
+    assert!(pure.report.after.inflections <= 1);
+}
+
+/// RMS distance of the points of a faired `noisy(n, _, _, false)` to the exact sine at the
+/// same abscissae.
+fn rms_to_sine(points: &[Point]) -> f64 {
+    let n = points.len();
+    let sum: f64 = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let x = 6.0 * i as f64 / (n - 1) as f64;
+            (p.x - x).powi(2) + (p.y - x.sin()).powi(2)
+        })
+        .sum();
+    (sum / n as f64).sqrt()
 }
 
 #[test]
-fn takes_three_noise_estimates_when_no_tolerance_is_given() {
+fn the_debiasing_stage_moves_closer_to_the_truth_and_stays_fair() {
+    for seed in [3, 7, 11] {
+        let input = noisy(400, 0.03, seed, false);
+        let run = |fit: f64| {
+            fair::fair(
+                "band",
+                &input,
+                &FairOptions::default().with_param("fit", fit),
+            )
+            .unwrap()
+        };
+        let (pure, debiased) = (run(0.0), run(1.25));
+        assert_eq!(pure.report.tolerance, debiased.report.tolerance);
+        assert!(debiased.report.max_displacement <= debiased.report.tolerance.unwrap());
+        assert!(
+            debiased
+                .report
+                .notes
+                .iter()
+                .any(|n| n.starts_with("debiasing stage")),
+            "{:?}",
+            debiased.report.notes
+        );
+        let (a, b) = (rms_to_sine(&pure.points), rms_to_sine(&debiased.points));
+        assert!(b < a, "seed {seed}: debiased {b} vs band alone {a}");
+        assert!(debiased.report.after.inflections <= 1, "seed {seed}");
+    }
+}
+
+#[test]
+fn takes_k_noise_estimates_when_no_tolerance_is_given() {
     let input = noisy(300, 0.03, 11, false);
     let out = fair::fair("band", &input, &FairOptions::default()).unwrap();
     let r = &out.report;
     assert_eq!(r.tolerance_source, Some(ToleranceSource::Auto));
     let sigma = r.noise_sigma.expect("noise estimate reported");
     let d = r.tolerance.expect("tolerance reported");
-    assert!((d - 3.0 * sigma).abs() <= 1e-12 * d, "{d} vs 3·{sigma}");
+    // k = max(3, √(2 ln n)): 3.38 at 300 points.
+    let k = fair::band_tolerance_factor(300);
+    assert!((k - (2.0 * 300f64.ln()).sqrt()).abs() < 1e-15 && k > 3.0);
+    assert_eq!(fair::band_tolerance_factor(50), 3.0);
+    assert!((d - k * sigma).abs() <= 1e-12 * d, "{d} vs {k}·{sigma}");
     assert!(r.max_displacement <= d);
     // `--set k=2` scales it.
     let two = fair::fair("band", &input, &FairOptions::default().with_param("k", 2)).unwrap();

@@ -1065,21 +1065,22 @@ impl Segment {
         }
     }
 
-    /// Move the consecutive interior points `start..start+gammas.len()` (one to four of them)
+    /// Move the consecutive interior points `start..start+gammas.len()` (one to five of them, as many as a case move
+    /// displaces)
     /// by `gammas`, with c and e updated exactly by eq 13 as after a case move, and the bounds
     /// applied the same way. Returns the fraction of the move that was applied (0 when the
     /// bounds or the resolution of y left nothing to do).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] when a moved point is not interior or there are not one to
-    /// four displacements; [`Error::NonFinite`] for a non-finite displacement.
+    /// five displacements; [`Error::NonFinite`] for a non-finite displacement.
     pub fn displace(&mut self, start: usize, gammas: &[f64]) -> Result<f64> {
-        if gammas.is_empty() || gammas.len() > 4 || start == 0 || start + gammas.len() >= self.len()
+        if gammas.is_empty() || gammas.len() > 5 || start == 0 || start + gammas.len() >= self.len()
         {
             return Err(Error::InvalidParameter {
                 name: "displace".into(),
                 reason: format!(
-                    "points {start}..{} are not 1 to 4 interior points of {}",
+                    "points {start}..{} are not 1 to 5 interior points of {}",
                     start + gammas.len(),
                     self.len()
                 ),

@@ -28,7 +28,7 @@ pub mod smoothing;
 
 use std::time::Instant;
 
-pub use band::Band;
+pub use band::{Band, auto_k as band_tolerance_factor};
 pub use cali::Cali;
 pub use catalogue::{MethodInfo, ParamInfo, ParamType, catalogue};
 pub use clean::LOCAL_CHECK_HALF_WIDTH;
@@ -125,13 +125,13 @@ pub trait FairMethod: Sync {
         false
     }
 
-    /// The factor `k` of an automatic tolerance `k·σ̂` for these options:
-    /// [`AUTO_TOLERANCE_K`] unless the method has a parameter for it.
+    /// The factor `k` of an automatic tolerance `k·σ̂` for these options and `n` input
+    /// points: [`AUTO_TOLERANCE_K`] unless the method has a parameter for it.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] for a bad value of that parameter.
-    fn auto_tolerance_factor(&self, options: &FairOptions) -> Result<f64> {
-        let _ = options;
+    fn auto_tolerance_factor(&self, options: &FairOptions, n: usize) -> Result<f64> {
+        let _ = (options, n);
         Ok(AUTO_TOLERANCE_K)
     }
 
@@ -289,7 +289,7 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
     let before = FairnessMetrics::of_seq(&in_unit(input, unit_scale)?)?;
     let start = Instant::now();
     let sigma = noise_sigma(input.points(), input.is_closed());
-    let (resolved, source) = resolve_tolerance(m, options, sigma, input.bbox().diagonal())?;
+    let (resolved, source) = resolve_tolerance(m, options, sigma, input)?;
     let options = &resolved;
     let held = options.fix_ends.held();
     let outcome = if !input.is_closed() && 2 * held >= input.len() {
@@ -339,8 +339,9 @@ fn resolve_tolerance(
     m: &dyn FairMethod,
     options: &FairOptions,
     sigma: f64,
-    diagonal: f64,
+    input: &PointSeq,
 ) -> Result<(FairOptions, Option<ToleranceSource>)> {
+    let diagonal = input.bbox().diagonal();
     let mut resolved = options.clone();
     if options.tolerance.is_some() {
         return Ok((resolved, Some(ToleranceSource::Given)));
@@ -348,7 +349,7 @@ fn resolve_tolerance(
     if !(options.auto_tolerance || m.auto_tolerance_by_default()) {
         return Ok((resolved, None));
     }
-    let k = m.auto_tolerance_factor(options)?;
+    let k = m.auto_tolerance_factor(options, input.len())?;
     let floor = AUTO_TOLERANCE_FLOOR_REL * diagonal.max(f64::MIN_POSITIVE);
     resolved.tolerance = Some((k * sigma).max(floor));
     resolved.auto_tolerance = false;

@@ -59,12 +59,36 @@ pub(super) struct Energy<const D: usize> {
     pub windows: Vec<Window<D>>,
 }
 
+/// The chord lengths of `shape`, cyclic when closed.
+pub(super) fn chords_of<const D: usize>(shape: &[[f64; D]], closed: bool) -> Vec<f64> {
+    let n = shape.len();
+    (0..if closed { n } else { n - 1 })
+        .map(|i| {
+            (0..D).fold(0.0_f64, |acc, a| {
+                acc.hypot(shape[i][a] - shape[(i + 1) % n][a])
+            })
+        })
+        .collect()
+}
+
 impl<const D: usize> Energy<D> {
     /// The energy at the chord-length parameters of `shape` (the current iterate), with the
     /// metric's tangents from `shape` too. `shape` has at least four points and no two
     /// consecutive ones equal (validated input, or a result inside its tolerance band of it,
     /// which the caller checks).
+    #[cfg(test)]
     pub fn build(shape: &[[f64; D]], closed: bool, metric: Metric) -> Energy<D> {
+        Self::build_with_chords(&chords_of(shape, closed), shape, closed, metric)
+    }
+
+    /// The energy with parameter steps `chords` (`n − 1` of them, `n` when closed; any
+    /// positive scale) and the metric's tangents from `shape`.
+    pub fn build_with_chords(
+        chords: &[f64],
+        shape: &[[f64; D]],
+        closed: bool,
+        metric: Metric,
+    ) -> Energy<D> {
         let n = shape.len();
         let dist = |a: &[f64; D], b: &[f64; D]| -> f64 {
             a.iter()
@@ -73,16 +97,13 @@ impl<const D: usize> Energy<D> {
                 .sum::<f64>()
                 .sqrt()
         };
-        let chords: Vec<f64> = (0..if closed { n } else { n - 1 })
-            .map(|i| dist(&shape[i], &shape[(i + 1) % n]))
-            .collect();
         let total: f64 = chords.iter().sum();
         let mean = total / chords.len() as f64;
         let floor = CHORD_FLOOR_REL * mean;
         let mut t = Vec::with_capacity(n + 1);
         t.push(0.0);
         let mut acc = 0.0;
-        for c in &chords {
+        for c in chords {
             acc += c.max(floor) / mean;
             t.push(acc);
         }

@@ -1,7 +1,7 @@
 //! `band`'s parameters, typed, with their defaults and ranges in one place.
 
 use crate::error::Result;
-use crate::fair::{AUTO_TOLERANCE_K, FairOptions, ParamSpec};
+use crate::fair::{FairOptions, ParamSpec};
 
 use super::energy::Metric;
 
@@ -11,6 +11,8 @@ use super::energy::Metric;
 pub const DEFAULT_PASSES: usize = 3;
 /// Default weight of the full jerk inside the minimum-variation energy.
 pub const DEFAULT_EPS: f64 = 0.02;
+/// Default residual target of the debiasing stage, in noise standard deviations.
+pub const DEFAULT_FIT: f64 = 1.25;
 /// Default interior-point iterations per pass (`--max-iterations`).
 pub const DEFAULT_MAX_ITERATIONS: usize = 200;
 
@@ -18,8 +20,8 @@ pub const DEFAULT_MAX_ITERATIONS: usize = 200;
 pub(super) const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "k",
-        default: "3",
-        doc: "automatic tolerance D = k·σ̂ (σ̂ the noise estimate), used when no tolerance is given; (0, 100]",
+        default: "auto",
+        doc: "automatic tolerance D = k·σ̂ (σ̂ the noise estimate), used when no tolerance is given; auto = max(3, √(2 ln n)), or a number in (0, 100]",
     },
     ParamSpec {
         name: "energy",
@@ -32,6 +34,11 @@ pub(super) const PARAMS: &[ParamSpec] = &[
         doc: "weight of the full jerk inside the min-variation energy, for regularity; [0, 10]",
     },
     ParamSpec {
+        name: "fit",
+        default: "1.25",
+        doc: "debiasing: the last stage moves back towards the data until the mean residual is fit·σ̂ per coordinate; 0 turns it off; [0, 10]",
+    },
+    ParamSpec {
         name: "passes",
         default: "3",
         doc: "solves, each re-taking parameters and tangents from the previous result; 1..=10",
@@ -41,14 +48,16 @@ pub(super) const PARAMS: &[ParamSpec] = &[
 /// The parameters as used.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct BandParams {
-    /// Factor of the automatic tolerance.
-    pub k: f64,
+    /// Factor of the automatic tolerance (`None`: [`super::auto_k`] of the point count).
+    pub k: Option<f64>,
     /// The energy of the passes after the first.
     pub metric: Metric,
     /// Number of passes.
     pub passes: usize,
     /// Interior-point iterations per pass.
     pub max_iterations: usize,
+    /// The debiasing stage's residual target, in noise standard deviations (0: no stage).
+    pub fit: f64,
 }
 
 impl BandParams {
@@ -57,7 +66,10 @@ impl BandParams {
     /// # Errors
     /// [`crate::Error::InvalidParameter`] naming the parameter and its range.
     pub fn from_options(options: &FairOptions) -> Result<BandParams> {
-        let k = options.param_f64_in("k", AUTO_TOLERANCE_K, f64::MIN_POSITIVE, 100.0)?;
+        let k = match options.params.get("k").map(|s| s.trim()) {
+            None | Some("auto") => None,
+            Some(_) => Some(options.param_f64_in("k", 3.0, f64::MIN_POSITIVE, 100.0)?),
+        };
         let eps = options.param_f64_in("eps", DEFAULT_EPS, 0.0, 10.0)?;
         let metric =
             match options.param_choice("energy", "min-variation", &["min-variation", "jerk"])? {
@@ -66,11 +78,13 @@ impl BandParams {
             };
         let passes = options.param_usize_in("passes", DEFAULT_PASSES, 1, 10)?;
         let max_iterations = options.iterations_or(DEFAULT_MAX_ITERATIONS);
+        let fit = options.param_f64_in("fit", DEFAULT_FIT, 0.0, 10.0)?;
         Ok(BandParams {
             k,
             metric,
             passes,
             max_iterations,
+            fit,
         })
     }
 }

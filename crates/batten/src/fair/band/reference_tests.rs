@@ -229,6 +229,7 @@ fn check(n: usize, closed: bool, metric: Metric, held_per_end: usize) {
         centres: a.iter().zip(&s).map(|(a, s)| a - s).collect(),
         held: &held,
         max_iterations: 500,
+        fidelity: 0.0,
     };
     let reference = clarabel_objective(&energy, &problem, &s);
     let sol = solve(&problem).expect("band solve");

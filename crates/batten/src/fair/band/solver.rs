@@ -89,6 +89,8 @@ pub(super) struct Problem<'a, const D: usize> {
     pub held: &'a [bool],
     /// Newton steps allowed.
     pub max_iterations: usize,
+    /// Weight `μ` of the data term `μ Σ |y_i − c_i|²` added to the objective (0: none).
+    pub fidelity: f64,
 }
 
 /// What [`solve`] found.
@@ -358,7 +360,12 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
     let objective = |y: &[f64], ay: &[f64]| -> f64 {
         let quad: f64 = y.iter().zip(ay).map(|(x, v)| x * v).sum();
         let lin: f64 = y.iter().zip(&p.anchor).map(|(x, v)| x * v).sum();
-        p.anchor_energy + 2.0 * lin + quad
+        let data: f64 = y
+            .iter()
+            .zip(&p.centres)
+            .map(|(x, c)| (x - c) * (x - c))
+            .sum();
+        p.anchor_energy + 2.0 * lin + quad + p.fidelity * data
     };
 
     let mut iterations = 0;
@@ -387,7 +394,7 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
             gap += st.lam[i] * st.sig[i];
             for a in 0..D {
                 let k = i * D + a;
-                rd[k] = grad[k] + 2.0 * st.lam[i] * st.off[k];
+                rd[k] = grad[k] + 2.0 * (st.lam[i] + p.fidelity) * st.off[k];
             }
         }
         let f = objective(&st.y, &ay);
@@ -420,7 +427,11 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
             let w = 4.0 * st.lam[i] / st.sig[i];
             for a in 0..D {
                 for c in 0..D {
-                    let id = if a == c { 2.0 * st.lam[i] } else { 0.0 };
+                    let id = if a == c {
+                        2.0 * (st.lam[i] + p.fidelity)
+                    } else {
+                        0.0
+                    };
                     blocks[i][a][c] = id + w * st.off[i * D + a] * st.off[i * D + c];
                 }
             }
