@@ -14,19 +14,22 @@
 //! - closed curves: cyclic differences, no ends.
 //!
 //! Neither the jerk nor the minimum-variation energy is a data-fit term: inside the band the
-//! result is as fair as the energy can make it, and no point leaves the band. (A least-squares
-//! term pulls the result back to the noise and brings spurious inflections back.)
+//! passes' result is as fair as the energy can make it, and no point leaves the band. That
+//! result flattens features by up to `D`; the debiasing stage (`debias.rs`) then adds a data
+//! term whose weight the noise decides (the discrepancy principle, parameter `fit`).
 //!
 //! # Passes
 //!
 //! The energy depends on the parameters and, for minimum variation, on the tangents of the
-//! curve it measures. The first pass takes both from the input with the jerk metric; each
-//! further pass takes them from the previous result with the minimum-variation metric (Moreton &
-//! Séquin's energy, re-weighted as in iteratively re-weighted least squares). Default: 3 passes.
+//! curve it measures. The first pass takes both from the input (averaged) with the jerk metric;
+//! each further pass keeps those parameters and takes the tangents from the previous result,
+//! with the minimum-variation metric (Moreton & Séquin's energy, re-weighted as in iteratively
+//! re-weighted least squares). Default: 3 passes.
 //!
 //! # The tolerance
 //!
-//! `--tolerance D`, or by default `D = k·σ̂` (`k = 3`, `--set k=`), with `σ̂` the noise estimate
+//! `--tolerance D`, or by default `D = k·σ̂` (`k = max(3, √(2 ln n))`, [`auto_k`]; `--set k=`),
+//! with `σ̂` the noise estimate
 //! of [`crate::analysis::noise_sigma`] (median absolute third difference along the local
 //! normal). The report gives `noise_sigma`, the `tolerance` and `tolerance_source`.
 //!
