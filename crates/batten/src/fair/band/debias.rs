@@ -2,7 +2,8 @@
 //!
 //! The passes give the fairest curve inside the band, and that curve lies on the band's inner
 //! edge wherever the energy gains by it: features are flattened by up to `D`, several noise
-//! standard deviations. The last stage adds a data term to the last pass's energy,
+//! standard deviations. The last stage adds a data term to the passes' energy (its metric
+//! re-taken from their result, as a further pass would),
 //!
 //! ```text
 //! minimise  E(q) + μ Σ_i |q_i − p_i|²      subject to the band, as before,
@@ -28,60 +29,110 @@ pub(super) const ENERGY_CAP: f64 = 4.0;
 /// leave `μ` within 1e-5 of itself, far below what the residual sees).
 const BISECTIONS: usize = 24;
 
-/// The penalised problem of one `μ`, in the solver's units (see `solver.rs`): `y` relative to
-/// the reference `s`, ball centres `c`.
-pub(super) struct Penalized<'a, const D: usize> {
-    pub energy: &'a Energy<D>,
-    pub held: &'a [bool],
-    /// `A s`.
-    pub anchor: &'a [f64],
-    /// `c = a − s`.
-    pub centres: &'a [f64],
+/// The matrix `2A` with the held points' rows and columns replaced by the identity, before
+/// the data weight is added.
+enum Base {
+    Open(SymBanded),
+    Closed(CyclicSymBanded),
 }
 
-impl<const D: usize> Penalized<'_, D> {
-    /// The unconstrained minimiser of `E(s + y) + μ |y − c|²` with held points at `c`:
-    /// `(2A + 2μ I) y = 2μ c − 2 A s` on the free rows.
-    fn minimiser(&self, mu: f64) -> Result<Vec<f64>> {
-        let n = self.energy.n;
-        let dim = n * D;
-        let held = self.held;
+/// The penalised problem, in the solver's units (see `solver.rs`): `y` relative to the
+/// reference `s`, ball centres `c`. Everything that does not depend on `μ` is assembled once
+/// by [`Penalized::new`]; each `μ` of the bisection then costs one copy, one diagonal and
+/// one banded factorisation.
+pub(super) struct Penalized<'a, const D: usize> {
+    energy: &'a Energy<D>,
+    held: &'a [bool],
+    /// `A s`.
+    anchor: &'a [f64],
+    /// `c = a − s`.
+    centres: &'a [f64],
+    base: Base,
+    /// `A` applied to the held points' centres (zero elsewhere): their columns, moved to the
+    /// right-hand side.
+    coupling: Vec<f64>,
+    /// The largest entry `2A` reports on the diagonal (one window's), the scale of rounding.
+    top: f64,
+}
+
+impl<'a, const D: usize> Penalized<'a, D> {
+    pub fn new(
+        energy: &'a Energy<D>,
+        held: &'a [bool],
+        anchor: &'a [f64],
+        centres: &'a [f64],
+    ) -> Penalized<'a, D> {
+        let dim = energy.n * D;
         // Held points sit at their centres: their columns go to the right-hand side.
         let fixed: Vec<f64> = (0..dim)
-            .map(|k| if held[k / D] { self.centres[k] } else { 0.0 })
+            .map(|k| if held[k / D] { centres[k] } else { 0.0 })
             .collect();
         let mut coupling = vec![0.0; dim];
-        self.energy.apply_add(&fixed, &mut coupling);
-        let mut y: Vec<f64> = (0..dim)
-            .map(|k| {
-                if held[k / D] {
-                    self.centres[k]
-                } else {
-                    2.0 * mu * self.centres[k] - 2.0 * self.anchor[k] - 2.0 * coupling[k]
-                }
-            })
-            .collect();
+        energy.apply_add(&fixed, &mut coupling);
         let bw = 4 * D - 1;
-        if self.energy.closed {
+        let base = if energy.closed {
             let mut m = CyclicSymBanded::zeros(dim, bw);
-            self.energy.for_each_lower(2.0, |r, c, v| m.add(r, c, v));
-            for k in 0..dim {
-                m.add(k, k, 2.0 * mu);
-            }
-            m.factorize()?;
-            m.solve_in_place(&mut y)?;
+            energy.for_each_lower(2.0, |r, c, v| m.add(r, c, v));
+            Base::Closed(m)
         } else {
             let mut m = SymBanded::zeros(dim, bw);
-            self.energy.for_each_lower(2.0, |r, c, v| {
+            energy.for_each_lower(2.0, |r, c, v| {
                 if !held[r / D] && !held[c / D] {
                     m.add(r, c, v);
                 }
             });
-            for k in 0..dim {
-                m.add(k, k, if held[k / D] { 1.0 } else { 2.0 * mu });
+            for k in (0..dim).filter(|k| held[k / D]) {
+                m.add(k, k, 1.0);
             }
-            m.factorize()?;
-            m.solve_in_place(&mut y)?;
+            Base::Open(m)
+        };
+        let mut top = 0.0_f64;
+        energy.for_each_lower(2.0, |r, c, v| {
+            if r == c {
+                top = top.max(v.abs());
+            }
+        });
+        Penalized {
+            energy,
+            held,
+            anchor,
+            centres,
+            base,
+            coupling,
+            top,
+        }
+    }
+
+    /// The unconstrained minimiser of `E(s + y) + μ |y − c|²` with held points at `c`:
+    /// `(2A + 2μ I) y = 2μ c − 2 A s` on the free rows.
+    fn minimiser(&self, mu: f64) -> Result<Vec<f64>> {
+        let held = self.held;
+        let mut y: Vec<f64> = (0..self.energy.n * D)
+            .map(|k| {
+                if held[k / D] {
+                    self.centres[k]
+                } else {
+                    2.0 * mu * self.centres[k] - 2.0 * self.anchor[k] - 2.0 * self.coupling[k]
+                }
+            })
+            .collect();
+        match &self.base {
+            Base::Closed(base) => {
+                let mut m = base.clone();
+                for k in 0..y.len() {
+                    m.add(k, k, 2.0 * mu);
+                }
+                m.factorize()?;
+                m.solve_in_place(&mut y)?;
+            }
+            Base::Open(base) => {
+                let mut m = base.clone();
+                for k in (0..y.len()).filter(|k| !held[k / D]) {
+                    m.add(k, k, 2.0 * mu);
+                }
+                m.factorize()?;
+                m.solve_in_place(&mut y)?;
+            }
         }
         Ok(y)
     }
@@ -127,14 +178,9 @@ impl<const D: usize> Penalized<'_, D> {
             return Ok(None);
         }
         // In units of the mean spacing a data weight μ smooths over about μ^(-1/6) points:
-        // from twice the curve down to a single point.
-        let mut top = 0.0_f64;
-        self.energy.for_each_lower(2.0, |r, c, v| {
-            if r == c {
-                top = top.max(v.abs());
-            }
-        });
-        let (mut lo, mut hi) = ((2.0 * n).powi(-6).max(1e-15 * top).ln(), 1.0_f64.ln());
+        // from twice the curve down to a single point, and no lower than rounding of `2A`
+        // leaves meaningful.
+        let (mut lo, mut hi) = ((2.0 * n).powi(-6).max(1e-15 * self.top).ln(), 1.0_f64.ln());
 
         // A weight so small that rounding makes the matrix singular (the energy's null space,
         // quadratics in the parameter, rests on `μ` alone) asks for more weight too.

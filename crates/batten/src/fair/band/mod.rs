@@ -259,89 +259,43 @@ fn fair_points<const D: usize>(
     let mut iterations = 0;
     let mut converged = true;
     let mut gap = 0.0;
-    for pass in 0..params.passes {
-        let metric = if pass == 0 {
-            Metric::Jerk
-        } else {
-            params.metric
-        };
-        let energy = Energy::build_with_chords(&chords, &shape, closed, metric);
-        let mut anchor = vec![0.0; n * D];
-        energy.apply_add(&reference, &mut anchor);
-        let problem = Problem {
-            energy: &energy,
-            anchor,
-            anchor_energy: energy.value(&reference),
-            centres: scaled.iter().zip(&reference).map(|(a, s)| a - s).collect(),
-            held,
-            max_iterations: params.max_iterations,
-            fidelity: 0.0,
-        };
-        let sol = solve(&problem)?;
+    // Each stage: one solve from the current reference, the result put into the band, a
+    // history row (`stage` counts from 1: the passes, then the debiasing stage).
+    let mut record = |sol: &solver::Solution, stage: usize, shape: &mut Vec<[f64; D]>| {
         iterations += sol.iterations;
         converged &= sol.converged;
         gap = sol.gap;
-        shape = into_band(pts, &sol.r, tolerance);
-        reference = scaled.iter().zip(&sol.r).map(|(a, r)| a + r).collect();
-        let max_distance = shape
-            .iter()
-            .zip(pts)
-            .map(|(q, p)| distance(q, p))
-            .fold(0.0_f64, f64::max);
+        *shape = into_band(pts, &sol.r, tolerance);
         history.push(HistoryRow {
-            iteration: pass + 1,
+            iteration: stage,
             measure: sol.objective,
-            max_distance,
+            max_distance: farthest(shape, pts),
         });
+    };
+    for pass in 0..params.passes {
+        let energy = Energy::build_with_chords(&chords, &shape, closed, pass_metric(pass, params));
+        let problem = band_problem(&energy, &reference, &scaled, held, params.max_iterations);
+        let sol = solve(&problem)?;
+        record(&sol, pass + 1, &mut shape);
+        reference = scaled.iter().zip(&sol.r).map(|(a, r)| a + r).collect();
     }
     let mut fidelity = None;
     if params.fit > 0.0 && noise_sigma > 0.0 {
-        let metric = if params.passes == 1 {
-            Metric::Jerk
-        } else {
-            params.metric
-        };
+        // The last pass's metric, its tangents re-taken from the passes' result.
+        let metric = pass_metric(params.passes - 1, params);
         let energy = Energy::build_with_chords(&chords, &shape, closed, metric);
-        let mut anchor = vec![0.0; n * D];
-        energy.apply_add(&reference, &mut anchor);
-        let anchor_energy = energy.value(&reference);
-        let centres: Vec<f64> = scaled.iter().zip(&reference).map(|(a, s)| a - s).collect();
-        let fit = Penalized {
-            energy: &energy,
-            held,
-            anchor: &anchor,
-            centres: &centres,
-        };
+        let mut problem = band_problem(&energy, &reference, &scaled, held, params.max_iterations);
+        let fit = Penalized::new(&energy, held, &problem.anchor, &problem.centres);
         let scaled_noise = params.fit * noise_sigma / tolerance;
         let target = D as f64 * scaled_noise * scaled_noise;
+        let anchor_energy = problem.anchor_energy;
         if let Some(mu) =
             fit.discrepancy_weight(anchor_energy, target, ENERGY_CAP * anchor_energy)?
         {
-            let problem = Problem {
-                energy: &energy,
-                anchor,
-                anchor_energy,
-                centres,
-                held,
-                max_iterations: params.max_iterations,
-                fidelity: mu,
-            };
+            problem.fidelity = mu;
             let sol = solve(&problem)?;
-            iterations += sol.iterations;
-            converged &= sol.converged;
-            gap = sol.gap;
-            shape = into_band(pts, &sol.r, tolerance);
+            record(&sol, params.passes + 1, &mut shape);
             fidelity = Some(mu);
-            let max_distance = shape
-                .iter()
-                .zip(pts)
-                .map(|(q, p)| distance(q, p))
-                .fold(0.0_f64, f64::max);
-            history.push(HistoryRow {
-                iteration: params.passes + 1,
-                measure: sol.objective,
-                max_distance,
-            });
         }
     }
     let on_edge = shape
@@ -360,6 +314,46 @@ fn fair_points<const D: usize>(
             points_on_band_edge: on_edge,
         },
     })
+}
+
+/// The metric of pass `pass` (from 0): the jerk first, then the parameters' metric.
+fn pass_metric(pass: usize, params: &BandParams) -> Metric {
+    if pass == 0 {
+        Metric::Jerk
+    } else {
+        params.metric
+    }
+}
+
+/// The band problem with the energy `energy` taken relative to `reference` (both in units of
+/// the tolerance, flat, like the input `scaled`), without a data term.
+fn band_problem<'a, const D: usize>(
+    energy: &'a Energy<D>,
+    reference: &[f64],
+    scaled: &[f64],
+    held: &'a [bool],
+    max_iterations: usize,
+) -> Problem<'a, D> {
+    let mut anchor = vec![0.0; reference.len()];
+    energy.apply_add(reference, &mut anchor);
+    Problem {
+        energy,
+        anchor,
+        anchor_energy: energy.value(reference),
+        centres: scaled.iter().zip(reference).map(|(a, s)| a - s).collect(),
+        held,
+        max_iterations,
+        fidelity: 0.0,
+    }
+}
+
+/// The largest distance of a point of `shape` from its input point.
+fn farthest<const D: usize>(shape: &[[f64; D]], pts: &[[f64; D]]) -> f64 {
+    shape
+        .iter()
+        .zip(pts)
+        .map(|(q, p)| distance(q, p))
+        .fold(0.0_f64, f64::max)
 }
 
 /// The half-width `m` of the parameter window: `⌊c·D / h⌋`, `c` =
