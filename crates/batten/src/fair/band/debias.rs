@@ -16,7 +16,9 @@
 //! so a bisection on `log μ` finds it, each step one banded solve, O(n). Where `σ̂`
 //! underestimates the noise the target cannot be met; the energy is then capped at
 //! [`ENERGY_CAP`] times the passes' optimum, so the stage never returns to the noise.
-//! The constrained problem is then solved once with that `μ` by the interior point.
+//! Where one `μ` still flattens a feature, [`Penalized::local_weights`] raises it there, from
+//! the residual's windowed means (see `docs/algorithms/band.md`, local data weights).
+//! The constrained problem is then solved once with those weights by the interior point.
 
 use super::energy::Energy;
 use crate::error::Result;
@@ -24,6 +26,11 @@ use crate::numeric::{CyclicSymBanded, SymBanded};
 
 /// The most the debiased energy may exceed the passes' optimum, as a factor.
 pub(super) const ENERGY_CAP: f64 = 4.0;
+
+/// Rounds of [`Penalized::local_weights`].
+const LOCAL_ROUNDS: usize = 6;
+/// The factor by which a round raises the data weight around a biased window.
+const LOCAL_FACTOR: f64 = 4.0;
 
 /// Bisection steps on `log μ` (the bracket spans 6·ln(2n) in `ln μ`, under 90 for 10⁶ points; 24 halvings
 /// leave `μ` within 1e-5 of itself, far below what the residual sees).
@@ -103,16 +110,18 @@ impl<'a, const D: usize> Penalized<'a, D> {
         }
     }
 
-    /// The unconstrained minimiser of `E(s + y) + μ |y − c|²` with held points at `c`:
-    /// `(2A + 2μ I) y = 2μ c − 2 A s` on the free rows.
-    fn minimiser(&self, mu: f64) -> Result<Vec<f64>> {
+    /// The unconstrained minimiser of `E(s + y) + Σ μ_i |y_i − c_i|²` with held points at `c`:
+    /// `(2A + 2 diag μ) y = 2 μ c − 2 A s` on the free rows (`weight(i)` gives `μ_i`).
+    fn minimiser(&self, weight: impl Fn(usize) -> f64) -> Result<Vec<f64>> {
         let held = self.held;
         let mut y: Vec<f64> = (0..self.energy.n * D)
             .map(|k| {
                 if held[k / D] {
                     self.centres[k]
                 } else {
-                    2.0 * mu * self.centres[k] - 2.0 * self.anchor[k] - 2.0 * self.coupling[k]
+                    2.0 * weight(k / D) * self.centres[k]
+                        - 2.0 * self.anchor[k]
+                        - 2.0 * self.coupling[k]
                 }
             })
             .collect();
@@ -120,7 +129,7 @@ impl<'a, const D: usize> Penalized<'a, D> {
             Base::Closed(base) => {
                 let mut m = base.clone();
                 for k in 0..y.len() {
-                    m.add(k, k, 2.0 * mu);
+                    m.add(k, k, 2.0 * weight(k / D));
                 }
                 m.factorize()?;
                 m.solve_in_place(&mut y)?;
@@ -128,7 +137,7 @@ impl<'a, const D: usize> Penalized<'a, D> {
             Base::Open(base) => {
                 let mut m = base.clone();
                 for k in (0..y.len()).filter(|k| !held[k / D]) {
-                    m.add(k, k, 2.0 * mu);
+                    m.add(k, k, 2.0 * weight(k / D));
                 }
                 m.factorize()?;
                 m.solve_in_place(&mut y)?;
@@ -184,7 +193,7 @@ impl<'a, const D: usize> Penalized<'a, D> {
 
         // A weight so small that rounding makes the matrix singular (the energy's null space,
         // quadratics in the parameter, rests on `μ` alone) asks for more weight too.
-        let more_data = |ln_mu: f64| match self.minimiser(ln_mu.exp()) {
+        let more_data = |ln_mu: f64| match self.minimiser(|_| ln_mu.exp()) {
             Ok(y) => {
                 self.mean_square_residual(&y) > target && self.energy_at(&y, anchor_energy) < cap
             }
@@ -202,5 +211,267 @@ impl<'a, const D: usize> Penalized<'a, D> {
             }
         }
         Ok(Some(hi.exp()))
+    }
+
+    /// Raise the data weight where the residual is biased: starting from `μ` everywhere,
+    /// each round computes the unconstrained minimiser, averages its residual `y − c` over a
+    /// window as long as the smoothing (`μ^(−1/6)` points), and multiplies the weights
+    /// around every window whose mean is significant for noise of standard deviation `noise`
+    /// per coordinate (`|mean|² · count > z² noise²`) by [`LOCAL_FACTOR`]. The residual of a
+    /// smoother fed only noise is high-frequency, so its windowed means stay well under that
+    /// threshold; a feature the energy flattens leaves a one-signed residual as long as the
+    /// feature, and is found. Stops when no window is significant, after [`LOCAL_ROUNDS`], or
+    /// before a round whose energy would pass `cap`. Returns the weights and the number of
+    /// points whose weight was raised.
+    pub fn local_weights(
+        &self,
+        mu: f64,
+        anchor_energy: f64,
+        cap: f64,
+        noise: f64,
+        z: f64,
+    ) -> Result<(Vec<f64>, usize)> {
+        let n = self.energy.n;
+        let mut weights = vec![mu; n];
+        if z <= 0.0 || noise <= 0.0 || n < 3 {
+            return Ok((weights, 0));
+        }
+        let threshold = z * z * noise * noise;
+        for _ in 0..LOCAL_ROUNDS {
+            let y = self.minimiser(|i| weights[i])?;
+            // The residual, zero at held points.
+            let residual: Vec<[f64; D]> = (0..n)
+                .map(|i| {
+                    let mut e = [0.0; D];
+                    if !self.held[i] {
+                        for (a, e) in e.iter_mut().enumerate() {
+                            *e = y[i * D + a] - self.centres[i * D + a];
+                        }
+                    }
+                    e
+                })
+                .collect();
+            let windows = Windows::new(&residual, self.held, self.energy.closed);
+            let mut raise = Marks::new(n, self.energy.closed);
+            let mut any = false;
+            for i in 0..n {
+                let half = windows.half_width(weights[i].powf(-1.0 / 6.0));
+                let (sum, count) = windows.sum(i, half);
+                if count == 0 {
+                    continue;
+                }
+                let norm2: f64 = sum.iter().map(|s| s * s).sum::<f64>() / count as f64;
+                if norm2 > threshold {
+                    any = true;
+                    raise.mark(i, half);
+                }
+            }
+            let raise = raise.finish();
+            if !any {
+                break;
+            }
+            let trial: Vec<f64> = weights
+                .iter()
+                .zip(&raise)
+                .map(|(w, r)| if *r { (w * LOCAL_FACTOR).min(1.0) } else { *w })
+                .collect();
+            let y = self.minimiser(|i| trial[i])?;
+            if self.energy_at(&y, anchor_energy) > cap {
+                break;
+            }
+            weights = trial;
+        }
+        let raised = weights.iter().filter(|w| **w > mu).count();
+        Ok((weights, raised))
+    }
+}
+
+/// Windowed sums of the free points' residuals in O(1) each, from prefix sums.
+struct Windows<const D: usize> {
+    /// `sums[j]`: the residuals of the free points before `j`, summed.
+    sums: Vec<[f64; D]>,
+    /// `counts[j]`: the free points before `j`.
+    counts: Vec<usize>,
+    closed: bool,
+}
+
+impl<const D: usize> Windows<D> {
+    fn new(residual: &[[f64; D]], held: &[bool], closed: bool) -> Windows<D> {
+        let mut sums = Vec::with_capacity(residual.len() + 1);
+        let mut counts = Vec::with_capacity(residual.len() + 1);
+        let (mut s, mut c) = ([0.0; D], 0);
+        sums.push(s);
+        counts.push(c);
+        for (e, h) in residual.iter().zip(held) {
+            if !h {
+                for a in 0..D {
+                    s[a] += e[a];
+                }
+                c += 1;
+            }
+            sums.push(s);
+            counts.push(c);
+        }
+        Windows {
+            sums,
+            counts,
+            closed,
+        }
+    }
+
+    fn n(&self) -> usize {
+        self.counts.len() - 1
+    }
+
+    /// The half-width of a window `length` points long: at least 2, and the window no longer
+    /// than the curve.
+    fn half_width(&self, length: f64) -> usize {
+        let most = if self.closed {
+            (self.n() - 1) / 2
+        } else {
+            self.n() / 2
+        };
+        ((0.5 * length).round().min(most as f64) as usize).clamp(most.min(2), most.max(1))
+    }
+
+    /// The sum over `[lo, hi)` of the prefix arrays, `0 ≤ lo ≤ hi ≤ n`.
+    fn between(&self, lo: usize, hi: usize) -> ([f64; D], usize) {
+        let mut s = [0.0; D];
+        for (a, s) in s.iter_mut().enumerate() {
+            *s = self.sums[hi][a] - self.sums[lo][a];
+        }
+        (s, self.counts[hi] - self.counts[lo])
+    }
+
+    /// The residuals summed over the window of half-width `half` about `i` (cyclic when
+    /// closed, else cut at the ends), and the number of free points in it.
+    fn sum(&self, i: usize, half: usize) -> ([f64; D], usize) {
+        let n = self.n();
+        if !self.closed {
+            return self.between(i.saturating_sub(half), (i + half + 1).min(n));
+        }
+        let lo = i as isize - half as isize;
+        let hi = i as isize + half as isize + 1;
+        let mut parts = Vec::with_capacity(2);
+        if lo < 0 {
+            parts.push(self.between((lo + n as isize) as usize, n));
+            parts.push(self.between(0, hi as usize));
+        } else if hi > n as isize {
+            parts.push(self.between(lo as usize, n));
+            parts.push(self.between(0, (hi - n as isize) as usize));
+        } else {
+            parts.push(self.between(lo as usize, hi as usize));
+        }
+        parts.into_iter().fold(([0.0; D], 0), |(mut s, c), (t, d)| {
+            for a in 0..D {
+                s[a] += t[a];
+            }
+            (s, c + d)
+        })
+    }
+}
+
+/// Windows marked on a curve of `n` points, in O(1) each, by a difference array.
+struct Marks {
+    diff: Vec<isize>,
+    closed: bool,
+}
+
+impl Marks {
+    fn new(n: usize, closed: bool) -> Marks {
+        Marks {
+            diff: vec![0; n + 1],
+            closed,
+        }
+    }
+
+    /// Mark the window of half-width `half` about `i`.
+    fn mark(&mut self, i: usize, half: usize) {
+        let n = self.diff.len() - 1;
+        let mut span = |lo: usize, hi: usize| {
+            self.diff[lo] += 1;
+            self.diff[hi] -= 1;
+        };
+        if !self.closed {
+            span(i.saturating_sub(half), (i + half + 1).min(n));
+            return;
+        }
+        let lo = i as isize - half as isize;
+        let hi = i as isize + half as isize + 1;
+        if lo < 0 {
+            span((lo + n as isize) as usize, n);
+            span(0, hi as usize);
+        } else if hi > n as isize {
+            span(lo as usize, n);
+            span(0, (hi - n as isize) as usize);
+        } else {
+            span(lo as usize, hi as usize);
+        }
+    }
+
+    /// Whether each point lies in a marked window.
+    fn finish(self) -> Vec<bool> {
+        let n = self.diff.len() - 1;
+        let mut depth = 0;
+        (0..n)
+            .map(|j| {
+                depth += self.diff[j];
+                depth > 0
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The window about `i` by brute force: indices `i − half ..= i + half`, wrapped when
+    /// closed, cut at the ends when open.
+    fn brute(i: usize, half: usize, n: usize, closed: bool) -> Vec<usize> {
+        (i as isize - half as isize..=i as isize + half as isize)
+            .filter_map(|j| {
+                if closed {
+                    Some(j.rem_euclid(n as isize) as usize)
+                } else if (0..n as isize).contains(&j) {
+                    Some(j as usize)
+                } else {
+                    None
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn window_sums_and_marks_match_brute_force() {
+        for closed in [false, true] {
+            for n in [3, 4, 7, 20] {
+                let residual: Vec<[f64; 2]> = (0..n)
+                    .map(|i| [(i as f64 * 0.7).sin(), (i as f64 * 1.3).cos()])
+                    .collect();
+                let held: Vec<bool> = (0..n).map(|i| i % 5 == 1).collect();
+                let windows = Windows::new(&residual, &held, closed);
+                for length in [0.0, 3.0, 6.0, 11.0, 100.0] {
+                    let half = windows.half_width(length);
+                    assert!(2 * half < n + usize::from(!closed), "{n} {half}");
+                    for i in 0..n {
+                        let (sum, count) = windows.sum(i, half);
+                        let idx = brute(i, half, n, closed);
+                        let free: Vec<usize> = idx.iter().copied().filter(|j| !held[*j]).collect();
+                        assert_eq!(count, free.len(), "{closed} {n} {i} {half}");
+                        for a in 0..2 {
+                            let want: f64 = free.iter().map(|j| residual[*j][a]).sum();
+                            assert!((sum[a] - want).abs() < 1e-12);
+                        }
+                        let mut marks = Marks::new(n, closed);
+                        marks.mark(i, half);
+                        let got = marks.finish();
+                        for (j, g) in got.iter().enumerate() {
+                            assert_eq!(*g, idx.contains(&j), "{closed} {n} {i} {half} {j}");
+                        }
+                    }
+                }
+            }
+        }
     }
 }

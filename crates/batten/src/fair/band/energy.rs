@@ -44,6 +44,9 @@ pub(super) enum Metric {
     MinVariation {
         /// Weight of the full jerk added for regularity.
         eps: f64,
+        /// Weight of the speed term: the tangential component of the second divided
+        /// difference, `v'` for a curve at speed `v` (0: none).
+        speed: f64,
     },
 }
 
@@ -67,6 +70,64 @@ pub(super) fn chords_of<const D: usize>(shape: &[[f64; D]], closed: bool) -> Vec
             (0..D).fold(0.0_f64, |acc, a| {
                 acc.hypot(shape[i][a] - shape[(i + 1) % n][a])
             })
+        })
+        .collect()
+}
+
+/// The speed term of the minimum-variation metric: for every three consecutive points, the
+/// second divided difference `Δ²_j` (`≈ C''/2`) weighed across nothing but the unit chord
+/// `τ_j = (q_{j+2} − q_j)/|…|` of `shape`, `w_j · speed · (τ_jᵀ Δ²_j)²`. For a curve at speed
+/// `v` that is `v'²/4`: zero at arc-length parameters, whatever the curvature. Without it the
+/// metric, blind along the tangent, lets points crowd where the curvature peaks, since there
+/// the normal jerk `3vv'κ + v³κ'` costs `v³` less (an airfoil's nose doubled its curvature).
+/// Each is stored as a window of four points with one coefficient zero (the last window of
+/// an open curve reaches back one point), so the energy keeps its band.
+fn speed_windows<const D: usize>(
+    n: usize,
+    closed: bool,
+    param: &impl Fn(usize) -> f64,
+    shape: &[[f64; D]],
+    speed: f64,
+) -> Vec<Window<D>> {
+    let count = if closed { n } else { n - 2 };
+    (0..count)
+        .map(|j| {
+            let ts = [param(j), param(j + 1), param(j + 2)];
+            let mut c = [0.0; 3];
+            for k in 0..3 {
+                let mut prod = 1.0;
+                for m in 0..3 {
+                    if m != k {
+                        prod *= ts[k] - ts[m];
+                    }
+                }
+                c[k] = 1.0 / prod;
+            }
+            let (p0, p2) = (&shape[j % n], &shape[(j + 2) % n]);
+            let len = (0..D).fold(0.0_f64, |acc, a| acc.hypot(p2[a] - p0[a]));
+            let mut tau = [0.0; D];
+            if len > 0.0 {
+                for a in 0..D {
+                    tau[a] = (p2[a] - p0[a]) / len;
+                }
+            }
+            let w = speed * (ts[2] - ts[0]);
+            let mut metric = [[0.0; D]; D];
+            for a in 0..D {
+                for b in 0..D {
+                    metric[a][b] = w * tau[a] * tau[b];
+                }
+            }
+            let (first, coef) = if closed || j + 3 < n {
+                (j, [c[0], c[1], c[2], 0.0])
+            } else {
+                (j - 1, [0.0, c[0], c[1], c[2]])
+            };
+            Window {
+                first,
+                coef,
+                metric,
+            }
         })
         .collect()
 }
@@ -131,7 +192,7 @@ impl<const D: usize> Energy<D> {
                             row[a] = w;
                         }
                     }
-                    Metric::MinVariation { eps } => {
+                    Metric::MinVariation { eps, .. } => {
                         let (p0, p3) = (&shape[j], &shape[(j + 3) % n]);
                         let len = dist(p0, p3);
                         let mut tau = [0.0; D];
@@ -154,7 +215,13 @@ impl<const D: usize> Energy<D> {
                     metric: m,
                 }
             })
-            .collect();
+            .collect::<Vec<_>>();
+        let mut windows = windows;
+        if let Metric::MinVariation { speed, .. } = metric
+            && speed > 0.0
+        {
+            windows.extend(speed_windows(n, closed, &param, shape, speed));
+        }
         Energy { n, closed, windows }
     }
 
@@ -288,7 +355,14 @@ mod tests {
     fn apply_matches_the_quadratic_form_and_the_lower_entries() {
         for closed in [false, true] {
             let pts = sample(11, |s| [(3.0 * s).cos() + 0.1 * s, (2.0 * s).sin()]);
-            let e = Energy::build(&pts, closed, Metric::MinVariation { eps: 0.05 });
+            let e = Energy::build(
+                &pts,
+                closed,
+                Metric::MinVariation {
+                    eps: 0.05,
+                    speed: 0.3,
+                },
+            );
             let n2 = 22;
             let mut dense = vec![vec![0.0; n2]; n2];
             e.for_each_lower(1.0, |r, c, v| {

@@ -156,24 +156,30 @@ impl FairMethod for Band {
             Some(k) => parameters.insert("k".into(), Value::from(k)),
             None => parameters.insert("k".into(), Value::from("auto")),
         };
-        let (energy, eps) = match params.metric {
-            Metric::Jerk => ("jerk", None),
-            Metric::MinVariation { eps } => ("min-variation", Some(eps)),
-        };
-        parameters.insert("energy".into(), Value::from(energy));
-        if let Some(eps) = eps {
+        parameters.insert(
+            "energy".into(),
+            Value::from(match params.metric {
+                Metric::Jerk => "jerk",
+                Metric::MinVariation { .. } => "min-variation",
+            }),
+        );
+        if let Metric::MinVariation { eps, speed } = params.metric {
             parameters.insert("eps".into(), Value::from(eps));
+            parameters.insert("speed".into(), Value::from(speed));
         }
         parameters.insert("passes".into(), Value::from(params.passes));
         parameters.insert("fit".into(), Value::from(params.fit));
+        parameters.insert("local".into(), Value::from(params.local));
         let notes = faired
             .fidelity
-            .map(|mu| {
+            .map(|(mu, raised)| {
                 vec![format!(
                     "debiasing stage: data weight {mu:.3e} (in units of the tolerance and the \
-                     mean spacing), for a mean residual of {}·σ̂ = {:.6e}",
+                     mean spacing), for a mean residual of {}·σ̂ = {:.6e}; raised at {raised} \
+                     of {} points where the residual was biased",
                     params.fit,
-                    params.fit * noise
+                    params.fit * noise,
+                    pts.len()
                 )]
             })
             .unwrap_or_default();
@@ -216,8 +222,9 @@ struct Faired<const D: usize> {
     points: Vec<[f64; D]>,
     converged: bool,
     history: Vec<HistoryRow>,
-    /// The data weight of the debiasing stage, when it ran.
-    fidelity: Option<f64>,
+    /// The data weight of the debiasing stage, when it ran, and the number of points whose
+    /// weight was raised locally.
+    fidelity: Option<(f64, usize)>,
     solver: SolverInfo,
 }
 
@@ -292,10 +299,17 @@ fn fair_points<const D: usize>(
         if let Some(mu) =
             fit.discrepancy_weight(anchor_energy, target, ENERGY_CAP * anchor_energy)?
         {
-            problem.fidelity = mu;
+            let (weights, raised) = fit.local_weights(
+                mu,
+                anchor_energy,
+                ENERGY_CAP * anchor_energy,
+                noise_sigma / tolerance,
+                params.local,
+            )?;
+            problem.fidelity = weights;
             let sol = solve(&problem)?;
             record(&sol, params.passes + 1, &mut shape);
-            fidelity = Some(mu);
+            fidelity = Some((mu, raised));
         }
     }
     let on_edge = shape
@@ -343,7 +357,7 @@ fn band_problem<'a, const D: usize>(
         centres: scaled.iter().zip(reference).map(|(a, s)| a - s).collect(),
         held,
         max_iterations,
-        fidelity: 0.0,
+        fidelity: Vec::new(),
     }
 }
 

@@ -9,6 +9,10 @@ use super::energy::Metric;
 /// previous result: the first with the jerk energy, the others with the minimum-variation
 /// energy.
 pub const DEFAULT_PASSES: usize = 3;
+/// Default significance of a biased window in the debiasing stage.
+pub(super) const DEFAULT_LOCAL: f64 = 2.0;
+/// Default weight of the speed term of the minimum-variation energy.
+pub(super) const DEFAULT_SPEED: f64 = 0.0;
 /// Default weight of the full jerk inside the minimum-variation energy.
 pub const DEFAULT_EPS: f64 = 0.02;
 /// Default residual target of the debiasing stage, in noise standard deviations.
@@ -34,9 +38,19 @@ pub(super) const PARAMS: &[ParamSpec] = &[
         doc: "weight of the full jerk inside the min-variation energy, for regularity; [0, 10]",
     },
     ParamSpec {
+        name: "speed",
+        default: "0",
+        doc: "weight of the speed term inside the min-variation energy (the tangential second difference: keeps points from crowding where the curvature peaks); [0, 1e6]",
+    },
+    ParamSpec {
         name: "fit",
         default: "1.25",
         doc: "debiasing: the last stage moves back towards the data until the mean residual is fit·σ̂ per coordinate; 0 turns it off; [0, 10]",
+    },
+    ParamSpec {
+        name: "local",
+        default: "2",
+        doc: "debiasing: the data weight is raised where the residual's mean over the smoothing length exceeds local·σ̂/√count (a flattened feature); 0 turns it off; [0, 100]",
     },
     ParamSpec {
         name: "passes",
@@ -58,6 +72,9 @@ pub(super) struct BandParams {
     pub max_iterations: usize,
     /// The debiasing stage's residual target, in noise standard deviations (0: no stage).
     pub fit: f64,
+    /// The significance of a biased window of the debiasing stage, in noise standard
+    /// deviations of its mean (0: one data weight everywhere).
+    pub local: f64,
 }
 
 impl BandParams {
@@ -71,15 +88,18 @@ impl BandParams {
             Some(_) => Some(options.param_f64_in("k", 3.0, f64::MIN_POSITIVE, 100.0)?),
         };
         let eps = options.param_f64_in("eps", DEFAULT_EPS, 0.0, 10.0)?;
+        let speed = options.param_f64_in("speed", DEFAULT_SPEED, 0.0, 1e6)?;
         let metric =
             match options.param_choice("energy", "min-variation", &["min-variation", "jerk"])? {
                 "jerk" => Metric::Jerk,
-                _ => Metric::MinVariation { eps },
+                _ => Metric::MinVariation { eps, speed },
             };
         let passes = options.param_usize_in("passes", DEFAULT_PASSES, 1, 10)?;
         let max_iterations = options.iterations_or(DEFAULT_MAX_ITERATIONS);
         let fit = options.param_f64_in("fit", DEFAULT_FIT, 0.0, 10.0)?;
+        let local = options.param_f64_in("local", DEFAULT_LOCAL, 0.0, 100.0)?;
         Ok(BandParams {
+            local,
             k,
             metric,
             passes,

@@ -229,7 +229,7 @@ fn check(n: usize, closed: bool, metric: Metric, held_per_end: usize) {
         centres: a.iter().zip(&s).map(|(a, s)| a - s).collect(),
         held: &held,
         max_iterations: 500,
-        fidelity: 0.0,
+        fidelity: Vec::new(),
     };
     let reference = clarabel_objective(&energy, &problem, &s);
     let sol = solve(&problem).expect("band solve");
@@ -266,11 +266,27 @@ fn open_jerk_matches_clarabel() {
 
 #[test]
 fn open_min_variation_with_held_ends_matches_clarabel() {
-    check(300, false, Metric::MinVariation { eps: 0.02 }, 2);
+    check(
+        300,
+        false,
+        Metric::MinVariation {
+            eps: 0.02,
+            speed: 0.0,
+        },
+        2,
+    );
 }
 
 #[test]
 fn closed_matches_clarabel() {
     check(300, true, Metric::Jerk, 0);
-    check(300, true, Metric::MinVariation { eps: 0.02 }, 0);
+    check(
+        300,
+        true,
+        Metric::MinVariation {
+            eps: 0.02,
+            speed: 0.0,
+        },
+        0,
+    );
 }

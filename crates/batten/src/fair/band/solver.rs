@@ -89,8 +89,9 @@ pub(super) struct Problem<'a, const D: usize> {
     pub held: &'a [bool],
     /// Newton steps allowed.
     pub max_iterations: usize,
-    /// Weight `μ` of the data term `μ Σ |y_i − c_i|²` added to the objective (0: none).
-    pub fidelity: f64,
+    /// Weights `μ_i` of the data term `Σ μ_i |y_i − c_i|²` added to the objective, one per
+    /// point (empty: none).
+    pub fidelity: Vec<f64>,
 }
 
 /// What [`solve`] found.
@@ -357,15 +358,17 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
     let mut work = vec![0.0; dim];
     let mut rhs = vec![0.0; dim];
 
+    let weight = |i: usize| p.fidelity.get(i).copied().unwrap_or(0.0);
     let objective = |y: &[f64], ay: &[f64]| -> f64 {
         let quad: f64 = y.iter().zip(ay).map(|(x, v)| x * v).sum();
         let lin: f64 = y.iter().zip(&p.anchor).map(|(x, v)| x * v).sum();
         let data: f64 = y
             .iter()
             .zip(&p.centres)
-            .map(|(x, c)| (x - c) * (x - c))
+            .enumerate()
+            .map(|(k, (x, c))| weight(k / D) * (x - c) * (x - c))
             .sum();
-        p.anchor_energy + 2.0 * lin + quad + p.fidelity * data
+        p.anchor_energy + 2.0 * lin + quad + data
     };
 
     let mut iterations = 0;
@@ -394,7 +397,7 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
             gap += st.lam[i] * st.sig[i];
             for a in 0..D {
                 let k = i * D + a;
-                rd[k] = grad[k] + 2.0 * (st.lam[i] + p.fidelity) * st.off[k];
+                rd[k] = grad[k] + 2.0 * (st.lam[i] + weight(i)) * st.off[k];
             }
         }
         let f = objective(&st.y, &ay);
@@ -428,7 +431,7 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
             for a in 0..D {
                 for c in 0..D {
                     let id = if a == c {
-                        2.0 * (st.lam[i] + p.fidelity)
+                        2.0 * (st.lam[i] + weight(i))
                     } else {
                         0.0
                     };
