@@ -346,28 +346,33 @@ impl<const D: usize> Windows<D> {
     /// The residuals summed over the window of half-width `half` about `i` (cyclic when
     /// closed, else cut at the ends), and the number of free points in it.
     fn sum(&self, i: usize, half: usize) -> ([f64; D], usize) {
-        let n = self.n();
-        if !self.closed {
-            return self.between(i.saturating_sub(half), (i + half + 1).min(n));
-        }
-        let lo = i as isize - half as isize;
-        let hi = i as isize + half as isize + 1;
-        let mut parts = Vec::with_capacity(2);
-        if lo < 0 {
-            parts.push(self.between((lo + n as isize) as usize, n));
-            parts.push(self.between(0, hi as usize));
-        } else if hi > n as isize {
-            parts.push(self.between(lo as usize, n));
-            parts.push(self.between(0, (hi - n as isize) as usize));
-        } else {
-            parts.push(self.between(lo as usize, hi as usize));
-        }
-        parts.into_iter().fold(([0.0; D], 0), |(mut s, c), (t, d)| {
+        let mut total = ([0.0; D], 0);
+        for (lo, hi) in spans(i, half, self.n(), self.closed) {
+            let (s, c) = self.between(lo, hi);
             for a in 0..D {
-                s[a] += t[a];
+                total.0[a] += s[a];
             }
-            (s, c + d)
-        })
+            total.1 += c;
+        }
+        total
+    }
+}
+
+/// The window of half-width `half` about `i` on a curve of `n` points as half-open index
+/// ranges: one, or two when a closed curve's window wraps (the second may be empty).
+fn spans(i: usize, half: usize, n: usize, closed: bool) -> [(usize, usize); 2] {
+    if !closed {
+        return [(i.saturating_sub(half), (i + half + 1).min(n)), (0, 0)];
+    }
+    let lo = i as isize - half as isize;
+    let hi = i as isize + half as isize + 1;
+    let n = n as isize;
+    if lo < 0 {
+        [((lo + n) as usize, n as usize), (0, hi as usize)]
+    } else if hi > n {
+        [(lo as usize, n as usize), (0, (hi - n) as usize)]
+    } else {
+        [(lo as usize, hi as usize), (0, 0)]
     }
 }
 
@@ -388,24 +393,11 @@ impl Marks {
     /// Mark the window of half-width `half` about `i`.
     fn mark(&mut self, i: usize, half: usize) {
         let n = self.diff.len() - 1;
-        let mut span = |lo: usize, hi: usize| {
-            self.diff[lo] += 1;
-            self.diff[hi] -= 1;
-        };
-        if !self.closed {
-            span(i.saturating_sub(half), (i + half + 1).min(n));
-            return;
-        }
-        let lo = i as isize - half as isize;
-        let hi = i as isize + half as isize + 1;
-        if lo < 0 {
-            span((lo + n as isize) as usize, n);
-            span(0, hi as usize);
-        } else if hi > n as isize {
-            span(lo as usize, n);
-            span(0, (hi - n as isize) as usize);
-        } else {
-            span(lo as usize, hi as usize);
+        for (lo, hi) in spans(i, half, n, self.closed) {
+            if lo < hi {
+                self.diff[lo] += 1;
+                self.diff[hi] -= 1;
+            }
         }
     }
 
