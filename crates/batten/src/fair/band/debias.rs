@@ -237,19 +237,11 @@ impl<'a, const D: usize> Penalized<'a, D> {
             return Ok((weights, 0));
         }
         let threshold = z * z * noise * noise;
+        let mut y = self.minimiser(|i| weights[i])?;
         for _ in 0..LOCAL_ROUNDS {
-            let y = self.minimiser(|i| weights[i])?;
-            // The residual, zero at held points.
+            // The residual (zero at held points, which the minimiser leaves at their centres).
             let residual: Vec<[f64; D]> = (0..n)
-                .map(|i| {
-                    let mut e = [0.0; D];
-                    if !self.held[i] {
-                        for (a, e) in e.iter_mut().enumerate() {
-                            *e = y[i * D + a] - self.centres[i * D + a];
-                        }
-                    }
-                    e
-                })
+                .map(|i| std::array::from_fn(|a| y[i * D + a] - self.centres[i * D + a]))
                 .collect();
             let windows = Windows::new(&residual, self.held, self.energy.closed);
             let mut raise = Marks::new(n, self.energy.closed);
@@ -266,20 +258,21 @@ impl<'a, const D: usize> Penalized<'a, D> {
                     raise.mark(i, half);
                 }
             }
-            let raise = raise.finish();
             if !any {
                 break;
             }
+            let raise = raise.finish();
             let trial: Vec<f64> = weights
                 .iter()
                 .zip(&raise)
                 .map(|(w, r)| if *r { (w * LOCAL_FACTOR).min(1.0) } else { *w })
                 .collect();
-            let y = self.minimiser(|i| trial[i])?;
-            if self.energy_at(&y, anchor_energy) > cap {
+            let trial_y = self.minimiser(|i| trial[i])?;
+            if self.energy_at(&trial_y, anchor_energy) > cap {
                 break;
             }
             weights = trial;
+            y = trial_y;
         }
         let raised = weights.iter().filter(|w| **w > mu).count();
         Ok((weights, raised))
@@ -324,14 +317,14 @@ impl<const D: usize> Windows<D> {
     }
 
     /// The half-width of a window `length` points long: at least 2, and the window no longer
-    /// than the curve.
+    /// than the curve (at least 1 for the three points a curve has at least).
     fn half_width(&self, length: f64) -> usize {
         let most = if self.closed {
             (self.n() - 1) / 2
         } else {
             self.n() / 2
         };
-        ((0.5 * length).round().min(most as f64) as usize).clamp(most.min(2), most.max(1))
+        ((0.5 * length).round() as usize).max(2).min(most)
     }
 
     /// The sum over `[lo, hi)` of the prefix arrays, `0 ≤ lo ≤ hi ≤ n`.

@@ -74,6 +74,38 @@ pub(super) fn chords_of<const D: usize>(shape: &[[f64; D]], closed: bool) -> Vec
         .collect()
 }
 
+/// The divided-difference coefficients at parameters `ts`: `c_k = 1 / Π_{m≠k} (t_k − t_m)`.
+fn divided_difference<const K: usize>(ts: [f64; K]) -> [f64; K] {
+    let mut coef = [0.0; K];
+    for (k, c) in coef.iter_mut().enumerate() {
+        let mut prod = 1.0;
+        for (m, tm) in ts.iter().enumerate() {
+            if m != k {
+                prod *= ts[k] - tm;
+            }
+        }
+        *c = 1.0 / prod;
+    }
+    coef
+}
+
+/// The unit vector from `a` to `b` (zero when they coincide).
+fn unit_chord<const D: usize>(a: &[f64; D], b: &[f64; D]) -> [f64; D] {
+    let len = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y) * (x - y))
+        .sum::<f64>()
+        .sqrt();
+    let mut tau = [0.0; D];
+    if len > 0.0 {
+        for (t, (x, y)) in tau.iter_mut().zip(a.iter().zip(b)) {
+            *t = (y - x) / len;
+        }
+    }
+    tau
+}
+
 /// The speed term of the minimum-variation metric: for every three consecutive points, the
 /// second divided difference `Δ²_j` (`≈ C''/2`) weighed across nothing but the unit chord
 /// `τ_j = (q_{j+2} − q_j)/|…|` of `shape`, `w_j · speed · (τ_jᵀ Δ²_j)²`. For a curve at speed
@@ -93,24 +125,8 @@ fn speed_windows<const D: usize>(
     (0..count)
         .map(|j| {
             let ts = [param(j), param(j + 1), param(j + 2)];
-            let mut c = [0.0; 3];
-            for k in 0..3 {
-                let mut prod = 1.0;
-                for m in 0..3 {
-                    if m != k {
-                        prod *= ts[k] - ts[m];
-                    }
-                }
-                c[k] = 1.0 / prod;
-            }
-            let (p0, p2) = (&shape[j % n], &shape[(j + 2) % n]);
-            let len = (0..D).fold(0.0_f64, |acc, a| acc.hypot(p2[a] - p0[a]));
-            let mut tau = [0.0; D];
-            if len > 0.0 {
-                for a in 0..D {
-                    tau[a] = (p2[a] - p0[a]) / len;
-                }
-            }
+            let c = divided_difference(ts);
+            let tau = unit_chord(&shape[j % n], &shape[(j + 2) % n]);
             let w = speed * (ts[2] - ts[0]);
             let mut metric = [[0.0; D]; D];
             for a in 0..D {
@@ -151,13 +167,6 @@ impl<const D: usize> Energy<D> {
         metric: Metric,
     ) -> Energy<D> {
         let n = shape.len();
-        let dist = |a: &[f64; D], b: &[f64; D]| -> f64 {
-            a.iter()
-                .zip(b)
-                .map(|(x, y)| (x - y) * (x - y))
-                .sum::<f64>()
-                .sqrt()
-        };
         let total: f64 = chords.iter().sum();
         let mean = total / chords.len() as f64;
         let floor = CHORD_FLOOR_REL * mean;
@@ -171,19 +180,10 @@ impl<const D: usize> Energy<D> {
         let period = if closed { acc } else { 0.0 };
         let param = |i: usize| -> f64 { if i >= n { t[i - n] + period } else { t[i] } };
         let count = if closed { n } else { n - 3 };
-        let windows = (0..count)
+        let mut windows: Vec<Window<D>> = (0..count)
             .map(|j| {
                 let ts = [param(j), param(j + 1), param(j + 2), param(j + 3)];
-                let mut coef = [0.0; 4];
-                for k in 0..4 {
-                    let mut prod = 1.0;
-                    for m in 0..4 {
-                        if m != k {
-                            prod *= ts[k] - ts[m];
-                        }
-                    }
-                    coef[k] = 1.0 / prod;
-                }
+                let coef = divided_difference(ts);
                 let w = ts[3] - ts[0];
                 let mut m = [[0.0; D]; D];
                 match metric {
@@ -193,14 +193,7 @@ impl<const D: usize> Energy<D> {
                         }
                     }
                     Metric::MinVariation { eps, .. } => {
-                        let (p0, p3) = (&shape[j], &shape[(j + 3) % n]);
-                        let len = dist(p0, p3);
-                        let mut tau = [0.0; D];
-                        if len > 0.0 {
-                            for a in 0..D {
-                                tau[a] = (p3[a] - p0[a]) / len;
-                            }
-                        }
+                        let tau = unit_chord(&shape[j], &shape[(j + 3) % n]);
                         for a in 0..D {
                             for b in 0..D {
                                 let id = if a == b { 1.0 } else { 0.0 };
@@ -215,8 +208,7 @@ impl<const D: usize> Energy<D> {
                     metric: m,
                 }
             })
-            .collect::<Vec<_>>();
-        let mut windows = windows;
+            .collect();
         if let Metric::MinVariation { speed, .. } = metric
             && speed > 0.0
         {

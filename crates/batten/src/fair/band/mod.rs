@@ -296,13 +296,12 @@ fn fair_points<const D: usize>(
         let scaled_noise = params.fit * noise_sigma / tolerance;
         let target = D as f64 * scaled_noise * scaled_noise;
         let anchor_energy = problem.anchor_energy;
-        if let Some(mu) =
-            fit.discrepancy_weight(anchor_energy, target, ENERGY_CAP * anchor_energy)?
-        {
+        let cap = ENERGY_CAP * anchor_energy;
+        if let Some(mu) = fit.discrepancy_weight(anchor_energy, target, cap)? {
             let (weights, raised) = fit.local_weights(
                 mu,
                 anchor_energy,
-                ENERGY_CAP * anchor_energy,
+                cap,
                 noise_sigma / tolerance,
                 params.local,
             )?;
