@@ -304,3 +304,22 @@ proptest! {
         prop_assert!(off <= 1e-6 * scale * tol, "off by {off:e} at scale {scale}");
     }
 }
+
+/// Dense points against the noise (20 000 points, noise about 5 spacings): rounding stops the
+/// solver short of its stopping rule (docs/algorithms/band.md, Limits). The report says so —
+/// status `stalled`, not the iteration limit, with the gap in a note — and the tolerance holds.
+#[test]
+fn a_run_that_rounding_stops_is_reported_as_stalled_within_the_tolerance() {
+    let input = noisy(20_000, 0.002, 3, false);
+    let out = fair::fair("band", &input, &FairOptions::default()).expect("band runs");
+    let r = &out.report;
+    assert_eq!(r.status, FairStatus::Stalled, "{:?}", r.notes);
+    assert!(r.iterations < 200, "stopped by rounding, not the limit");
+    assert!(
+        r.notes.iter().any(|n| n.contains("stopped short")),
+        "{:?}",
+        r.notes
+    );
+    let d = r.tolerance.expect("auto tolerance");
+    assert!(r.tolerance_met && max_move(input.points(), &out.points) <= d);
+}

@@ -18,6 +18,9 @@ pub enum FairStatus {
     ToleranceLimited,
     /// The result exceeds the tolerance (the method could not meet it).
     ToleranceExceeded,
+    /// Rounding stopped the solver's progress before its stopping rule was met: the result
+    /// meets the tolerance but may not be the optimum (a note gives how far it was).
+    Stalled,
     /// Nothing changed: the input is already fair by the method's criterion, or the
     /// clean-curve guard returned the input because the result was worse (a note says so).
     NoChange,

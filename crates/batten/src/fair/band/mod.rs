@@ -170,19 +170,29 @@ impl FairMethod for Band {
         parameters.insert("passes".into(), Value::from(params.passes));
         parameters.insert("fit".into(), Value::from(params.fit));
         parameters.insert("local".into(), Value::from(params.local));
-        let notes = faired
+        let mut notes: Vec<String> = faired
             .fidelity
             .map(|(mu, raised)| {
-                vec![format!(
+                format!(
                     "debiasing stage: data weight {mu:.3e} (in units of the tolerance and the \
                      mean spacing), for a mean residual of {}·σ̂ = {:.6e}; raised at {raised} \
                      of {} points where the residual was biased",
                     params.fit,
                     params.fit * noise,
                     pts.len()
-                )]
+                )
             })
-            .unwrap_or_default();
+            .into_iter()
+            .collect();
+        if let Some(gap) = faired.stalled {
+            notes.push(format!(
+                "the solver stopped short of its stopping rule: rounding stopped its progress at \
+                 a relative duality gap of {gap:.1e}; the result is inside the band but may \
+                 not be the fairest one. This happens when the points are dense against the \
+                 noise (the energy's long waves fall below double precision); see \
+                 docs/algorithms/band.md, Limits"
+            ));
+        }
         let points: Vec<Point> = faired
             .points
             .iter()
@@ -192,6 +202,8 @@ impl FairMethod for Band {
             points,
             status: if faired.converged {
                 FairStatus::Converged
+            } else if faired.stalled.is_some() {
+                FairStatus::Stalled
             } else {
                 FairStatus::IterationLimit
             },
@@ -221,6 +233,9 @@ fn held_mask(n: usize, closed: bool, held: usize) -> Vec<bool> {
 struct Faired<const D: usize> {
     points: Vec<[f64; D]>,
     converged: bool,
+    /// When rounding stopped a stage short of its stopping rule (not the iteration limit):
+    /// the largest relative duality gap such a stage ended with.
+    stalled: Option<f64>,
     history: Vec<HistoryRow>,
     /// The data weight of the debiasing stage, when it ran, and the number of points whose
     /// weight was raised locally.
@@ -265,12 +280,18 @@ fn fair_points<const D: usize>(
     let mut history = Vec::with_capacity(params.passes);
     let mut iterations = 0;
     let mut converged = true;
+    let mut stalled = None;
     let mut gap = 0.0;
     // Each stage: one solve from the current reference, the result put into the band, a
     // history row (`stage` counts from 1: the passes, then the debiasing stage).
     let mut record = |sol: &solver::Solution, stage: usize, shape: &mut Vec<[f64; D]>| {
         iterations += sol.iterations;
         converged &= sol.converged;
+        if !sol.converged && sol.iterations < params.max_iterations {
+            // Stopped by rounding, not by the iteration limit: keep the worst stage's gap.
+            let worst: f64 = stalled.unwrap_or(0.0);
+            stalled = Some(worst.max(sol.gap));
+        }
         gap = sol.gap;
         *shape = into_band(pts, &sol.r, tolerance);
         history.push(HistoryRow {
@@ -319,6 +340,7 @@ fn fair_points<const D: usize>(
     Ok(Faired {
         points: shape,
         converged,
+        stalled,
         history,
         fidelity,
         solver: SolverInfo {
