@@ -734,7 +734,7 @@ fn least_change(pw: &[H], first: usize, last: usize, alpha: &dyn Fn(usize) -> f6
 
 /// `max_{t ∈ [lo, hi]} |a(t) − b(t)|`, span by span over the knot spans of `a` (whose knots
 /// must contain those of `b`, so both are smooth on each span): samples, then Brent's method
-/// around the best sample of each span. Only the spans meeting `[lo, hi]` are visited, so a
+/// around every local maximum of a span's samples. Only the spans meeting `[lo, hi]` are visited, so a
 /// local removal costs O(p) evaluations whatever the size of the curve.
 fn max_deviation(a: &BSplineCurve, b: &BSplineCurve, lo: f64, hi: f64) -> f64 {
     let (d0, d1) = a.domain();
@@ -758,12 +758,11 @@ fn max_deviation(a: &BSplineCurve, b: &BSplineCurve, lo: f64, hi: f64) -> f64 {
                 s0 + h * j as f64
             }
         };
-        let samples: Vec<f64> = (0..=DEVIATION_SAMPLES_PER_SPAN)
-            .map(|j| dist(at(j)))
-            .collect();
+        let samples: [f64; DEVIATION_SAMPLES_PER_SPAN + 1] = std::array::from_fn(|j| dist(at(j)));
         // Every local maximum of the samples is refined, not only the largest: the distance
         // of two rational curves can have two bumps in one span, and the taller one need not
-        // have the taller sample (a degree-1 rational removal was 0.08 % under-reported).
+        // have the taller sample (a degree-1 rational removal was 0.08 % under-reported: the
+        // case in tests/foundation.proptest-regressions).
         for j in 0..samples.len() {
             let left = j.checked_sub(1).map_or(f64::NEG_INFINITY, |k| samples[k]);
             let right = samples.get(j + 1).copied().unwrap_or(f64::NEG_INFINITY);
@@ -799,49 +798,6 @@ mod tests {
             0.0, 0.0, 0.0, 0.0, 0.1, 0.3, 0.45, 0.5, 0.8, 1.0, 1.0, 1.0, 1.0,
         ]);
         BSplineCurve::new(3, knots, pts, None)
-    }
-
-    /// A rational degree-1 removal whose deviation has two bumps in one span: the reported
-    /// deviation must bound a dense sample (it was 0.08 % under, from the smaller bump).
-    #[test]
-    fn rational_removal_deviation_bounds_a_dense_sample() {
-        let c = BSplineCurve::new(
-            1,
-            KnotVector::new(vec![
-                0.0,
-                0.0,
-                0.130_737_296_223_261_38,
-                0.638_643_746_985_675_2,
-                1.0,
-                1.0,
-            ]),
-            vec![
-                Point::new(9.656_085_850_433, -5.576_640_993_939_439_5),
-                Point::new(7.194_962_890_862_715, -3.440_494_468_615_895_6),
-                Point::new(3.189_859_194_220_272_5, 4.397_724_726_898_442),
-                Point::new(0.0, 0.0),
-            ],
-            Some(vec![
-                0.983_110_389_624_265_2,
-                0.758_622_414_204_833_3,
-                1.292_777_640_098_311,
-                0.3,
-            ]),
-        );
-        let rem = c
-            .remove_knot_exact(KnotRef::Value(0.130_737_296_223_261_38), RemovalRule::Left)
-            .unwrap();
-        let sampled = (0..=4000)
-            .map(|i| {
-                let t = i as f64 / 4000.0;
-                (c.eval(t) - rem.curve.eval(t)).length()
-            })
-            .fold(0.0_f64, f64::max);
-        assert!(
-            sampled <= rem.max_deviation * (1.0 + 1e-9) + 1e-12,
-            "sampled {sampled:e} > reported {:e}",
-            rem.max_deviation
-        );
     }
 
     #[test]

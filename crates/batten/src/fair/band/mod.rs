@@ -289,8 +289,7 @@ fn fair_points<const D: usize>(
         converged &= sol.converged;
         if !sol.converged && sol.iterations < params.max_iterations {
             // Stopped by rounding, not by the iteration limit: keep the worst stage's gap.
-            let worst: f64 = stalled.unwrap_or(0.0);
-            stalled = Some(worst.max(sol.gap));
+            stalled = Some(stalled.map_or(sol.gap, |g: f64| g.max(sol.gap)));
         }
         gap = sol.gap;
         *shape = into_band(pts, &sol.r, tolerance);
