@@ -20,6 +20,7 @@
 //! the residual's windowed means (see `docs/algorithms/band.md`, local data weights).
 //! The constrained problem is then solved once with those weights by the interior point.
 
+use super::design::Design;
 use super::energy::Energy;
 use crate::error::Result;
 use crate::numeric::{CyclicSymBanded, SymBanded};
@@ -36,43 +37,84 @@ const LOCAL_FACTOR: f64 = 4.0;
 /// leave `μ` within 1e-5 of itself, far below what the residual sees).
 const BISECTIONS: usize = 24;
 
-/// The matrix `2A` with the held points' rows and columns replaced by the identity, before
+/// The matrix `2A` with the held unknowns' rows and columns replaced by the identity, before
 /// the data weight is added.
+#[derive(Clone)]
 enum Base {
     Open(SymBanded),
     Closed(CyclicSymBanded),
 }
 
+impl Base {
+    fn add(&mut self, r: usize, c: usize, v: f64) {
+        match self {
+            Base::Open(m) => m.add(r, c, v),
+            Base::Closed(m) => m.add(r, c, v),
+        }
+    }
+
+    fn factorize_and_solve(mut self, y: &mut [f64]) -> Result<()> {
+        match &mut self {
+            Base::Open(m) => {
+                m.factorize()?;
+                m.solve_in_place(y)
+            }
+            Base::Closed(m) => {
+                m.factorize()?;
+                m.solve_in_place(y)
+            }
+        }
+    }
+}
+
 /// The penalised problem, in the solver's units (see `solver.rs`): `y` relative to the
-/// reference `s`, ball centres `c`. Everything that does not depend on `μ` is assembled once
-/// by [`Penalized::new`]; each `μ` of the bisection then costs one copy, one diagonal and
-/// one banded factorisation.
+/// reference `s`, ball centres `c`, points `B y`. Everything that does not depend on `μ` is
+/// assembled once by [`Penalized::new`]; each `μ` of the bisection then costs one copy, the
+/// data term (a diagonal in the point form, the Gram matrix `BᵀB` times `μ` in the spline
+/// form) and one banded factorisation.
 pub(super) struct Penalized<'a, const D: usize> {
     energy: &'a Energy<D>,
+    design: &'a Design,
     held: &'a [bool],
+    pinned: &'a [bool],
     /// `A s`.
     anchor: &'a [f64],
-    /// `c = a − s`.
+    /// `c = a − B s`.
     centres: &'a [f64],
+    /// The held unknowns' values (zero elsewhere).
+    fixed: Vec<f64>,
     base: Base,
-    /// `A` applied to the held points' centres (zero elsewhere): their columns, moved to the
-    /// right-hand side.
+    /// `A` applied to the held unknowns' values: their columns, moved to the right-hand side.
     coupling: Vec<f64>,
+    /// `2 BᵀB` on the free unknowns, lower entries (the spline form; empty for points).
+    gram: Vec<(usize, usize, f64)>,
+    /// `c − B x_held` at the free points (zero at pinned ones).
+    shifted: Vec<f64>,
+    /// `2 Bᵀ (c − B x_held)`.
+    pull: Vec<f64>,
     /// The largest entry `2A` reports on the diagonal (one window's), the scale of rounding.
     top: f64,
+    /// The energy's scale against the point form's units (parameters in mean spacings): a
+    /// data weight `μ` smooths over about `(μ / unit)^(−1/6)` points.
+    unit: f64,
 }
 
 impl<'a, const D: usize> Penalized<'a, D> {
+    /// `fixed` gives the held unknowns' values, `unit` the energy's scale.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         energy: &'a Energy<D>,
+        unit: f64,
+        design: &'a Design,
         held: &'a [bool],
+        pinned: &'a [bool],
+        fixed: &[f64],
         anchor: &'a [f64],
         centres: &'a [f64],
     ) -> Penalized<'a, D> {
         let dim = energy.n * D;
-        // Held points sit at their centres: their columns go to the right-hand side.
         let fixed: Vec<f64> = (0..dim)
-            .map(|k| if held[k / D] { centres[k] } else { 0.0 })
+            .map(|k| if held[k / D] { fixed[k] } else { 0.0 })
             .collect();
         let mut coupling = vec![0.0; dim];
         energy.apply_add(&fixed, &mut coupling);
@@ -99,50 +141,116 @@ impl<'a, const D: usize> Penalized<'a, D> {
                 top = top.max(v.abs());
             }
         });
+        let mut gram = Vec::new();
+        if let Design::Spline(_) = design {
+            // Summed in a band array (offsets `c − r` in `[−bw, bw]`, wrapped for closed
+            // curves), then listed.
+            let width = 2 * bw + 1;
+            let mut band = vec![0.0; dim * width];
+            let unit = vec![identity::<D>(2.0); design.points()];
+            design.for_each_block_lower::<D>(&unit, pinned, |r, c, v| {
+                if !held[r / D] && !held[c / D] {
+                    band[r * width + offset(r, c, dim, bw)] += v;
+                }
+            });
+            for (k, v) in band.iter().enumerate() {
+                if *v != 0.0 {
+                    let r = k / width;
+                    let c = (r + dim + k % width - bw) % dim;
+                    gram.push((r, c, *v));
+                }
+            }
+        }
+        // The data term's pull on the free unknowns: towards the centres less what the held
+        // unknowns already give the points (in the point form they give only their own).
+        let mut shifted = vec![0.0; design.points() * D];
+        design.eval::<D>(&fixed, &mut shifted);
+        for (k, (s, c)) in shifted.iter_mut().zip(centres).enumerate() {
+            *s = if pinned[k / D] { 0.0 } else { c - *s };
+        }
+        let mut pull = vec![0.0; dim];
+        let doubled: Vec<f64> = shifted.iter().map(|s| 2.0 * s).collect();
+        design.eval_t_add::<D>(&doubled, &mut pull);
         Penalized {
             energy,
+            design,
             held,
+            pinned,
             anchor,
             centres,
+            fixed,
             base,
             coupling,
+            gram,
+            pull,
+            shifted,
             top,
+            unit,
         }
     }
 
-    /// The unconstrained minimiser of `E(s + y) + Σ μ_i |y_i − c_i|²` with held points at `c`:
-    /// `(2A + 2 diag μ) y = 2 μ c − 2 A s` on the free rows (`weight(i)` gives `μ_i`).
-    fn minimiser(&self, weight: impl Fn(usize) -> f64) -> Result<Vec<f64>> {
+    /// The number of points.
+    fn points(&self) -> usize {
+        self.design.points()
+    }
+
+    /// The unconstrained minimiser of `E(s + y) + Σ μ_i |(B y)_i − c_i|²` with the held
+    /// unknowns at their values: `(2A + 2 Bᵀ diag μ B) y = 2 Bᵀ μ c − 2 A s` on the free rows
+    /// (`weight(i)` gives `μ_i` of point `i`; `uniform` when every point has the same one).
+    pub fn minimiser(&self, weight: impl Fn(usize) -> f64, uniform: bool) -> Result<Vec<f64>> {
         let held = self.held;
-        let mut y: Vec<f64> = (0..self.energy.n * D)
-            .map(|k| {
-                if held[k / D] {
-                    self.centres[k]
-                } else {
-                    2.0 * weight(k / D) * self.centres[k]
-                        - 2.0 * self.anchor[k]
-                        - 2.0 * self.coupling[k]
+        let dim = self.energy.n * D;
+        let mut m = self.base.clone();
+        let mut y = vec![0.0; dim];
+        match self.design {
+            Design::Points { .. } => {
+                for (k, yk) in y.iter_mut().enumerate() {
+                    *yk = 2.0 * weight(k / D) * self.centres[k];
                 }
-            })
-            .collect();
-        match &self.base {
-            Base::Closed(base) => {
-                let mut m = base.clone();
-                for k in 0..y.len() {
-                    m.add(k, k, 2.0 * weight(k / D));
+                let skip = matches!(m, Base::Open(_));
+                for k in 0..dim {
+                    if !(skip && held[k / D]) {
+                        m.add(k, k, 2.0 * weight(k / D));
+                    }
                 }
-                m.factorize()?;
-                m.solve_in_place(&mut y)?;
             }
-            Base::Open(base) => {
-                let mut m = base.clone();
-                for k in (0..y.len()).filter(|k| !held[k / D]) {
-                    m.add(k, k, 2.0 * weight(k / D));
+            Design::Spline(_) => {
+                if uniform {
+                    let mu = weight(0);
+                    for (k, yk) in y.iter_mut().enumerate() {
+                        *yk = mu * self.pull[k];
+                    }
+                    for (r, c, v) in &self.gram {
+                        m.add(*r, *c, mu * v);
+                    }
+                } else {
+                    let n = self.points();
+                    let blocks: Vec<[[f64; D]; D]> =
+                        (0..n).map(|i| identity::<D>(2.0 * weight(i))).collect();
+                    self.design
+                        .for_each_block_lower::<D>(&blocks, self.pinned, |r, c, v| {
+                            if !held[r / D] && !held[c / D] {
+                                m.add(r, c, v);
+                            }
+                        });
+                    let weighted: Vec<f64> = self
+                        .shifted
+                        .iter()
+                        .enumerate()
+                        .map(|(k, c)| 2.0 * weight(k / D) * c)
+                        .collect();
+                    self.design.eval_t_add::<D>(&weighted, &mut y);
                 }
-                m.factorize()?;
-                m.solve_in_place(&mut y)?;
             }
         }
+        for (k, yk) in y.iter_mut().enumerate() {
+            *yk = if held[k / D] {
+                self.fixed[k]
+            } else {
+                *yk - 2.0 * self.anchor[k] - 2.0 * self.coupling[k]
+            };
+        }
+        m.factorize_and_solve(&mut y)?;
         Ok(y)
     }
 
@@ -155,14 +263,20 @@ impl<'a, const D: usize> Penalized<'a, D> {
         anchor_energy + 2.0 * lin + quad
     }
 
-    /// The mean squared residual `(1/free) Σ |y_i − c_i|²` over the free points.
+    /// The residual `B y − c` of every point (zero at pinned points).
+    pub fn residual(&self, y: &[f64]) -> Vec<f64> {
+        let mut r = vec![0.0; self.points() * D];
+        self.design.eval::<D>(y, &mut r);
+        for (k, (rk, c)) in r.iter_mut().zip(self.centres).enumerate() {
+            *rk = if self.pinned[k / D] { 0.0 } else { *rk - c };
+        }
+        r
+    }
+
+    /// The mean squared residual `(1/free) Σ |(B y)_i − c_i|²` over the free points.
     fn mean_square_residual(&self, y: &[f64]) -> f64 {
-        let free = self.held.iter().filter(|h| !**h).count().max(1);
-        let sum: f64 = y
-            .iter()
-            .zip(self.centres)
-            .map(|(a, c)| (a - c) * (a - c))
-            .sum();
+        let free = self.pinned.iter().filter(|h| !**h).count().max(1);
+        let sum: f64 = self.residual(y).iter().map(|r| r * r).sum();
         sum / free as f64
     }
 
@@ -176,8 +290,8 @@ impl<'a, const D: usize> Penalized<'a, D> {
         target: f64,
         cap: f64,
     ) -> Result<Option<f64>> {
-        let n = self.energy.n as f64;
-        let reference_residual = self.mean_square_residual(&vec![0.0; self.centres.len()]);
+        let n = self.points() as f64;
+        let reference_residual = self.mean_square_residual(&self.fixed);
         if target.is_nan()
             || target <= 0.0
             || reference_residual <= target
@@ -189,11 +303,15 @@ impl<'a, const D: usize> Penalized<'a, D> {
         // In units of the mean spacing a data weight μ smooths over about μ^(-1/6) points:
         // from twice the curve down to a single point, and no lower than rounding of `2A`
         // leaves meaningful.
-        let (mut lo, mut hi) = ((2.0 * n).powi(-6).max(1e-15 * self.top).ln(), 1.0_f64.ln());
+        let unit = self.unit;
+        let (mut lo, mut hi) = (
+            (unit * (2.0 * n).powi(-6)).max(1e-15 * self.top).ln(),
+            unit.ln(),
+        );
 
         // A weight so small that rounding makes the matrix singular (the energy's null space,
         // quadratics in the parameter, rests on `μ` alone) asks for more weight too.
-        let more_data = |ln_mu: f64| match self.minimiser(|_| ln_mu.exp()) {
+        let more_data = |ln_mu: f64| match self.minimiser(|_| ln_mu.exp(), true) {
             Ok(y) => {
                 self.mean_square_residual(&y) > target && self.energy_at(&y, anchor_energy) < cap
             }
@@ -231,23 +349,24 @@ impl<'a, const D: usize> Penalized<'a, D> {
         noise: f64,
         z: f64,
     ) -> Result<(Vec<f64>, usize)> {
-        let n = self.energy.n;
+        let n = self.points();
         let mut weights = vec![mu; n];
         if z <= 0.0 || noise <= 0.0 || n < 3 {
             return Ok((weights, 0));
         }
         let threshold = z * z * noise * noise;
-        let mut y = self.minimiser(|i| weights[i])?;
+        let mut y = self.minimiser(|i| weights[i], false)?;
         for _ in 0..LOCAL_ROUNDS {
             // The residual (zero at held points, which the minimiser leaves at their centres).
+            let flat = self.residual(&y);
             let residual: Vec<[f64; D]> = (0..n)
-                .map(|i| std::array::from_fn(|a| y[i * D + a] - self.centres[i * D + a]))
+                .map(|i| std::array::from_fn(|a| flat[i * D + a]))
                 .collect();
-            let windows = Windows::new(&residual, self.held, self.energy.closed);
+            let windows = Windows::new(&residual, self.pinned, self.energy.closed);
             let mut raise = Marks::new(n, self.energy.closed);
             let mut any = false;
             for i in 0..n {
-                let half = windows.half_width(weights[i].powf(-1.0 / 6.0));
+                let half = windows.half_width((weights[i] / self.unit).powf(-1.0 / 6.0));
                 let (sum, count) = windows.sum(i, half);
                 if count == 0 {
                     continue;
@@ -265,9 +384,15 @@ impl<'a, const D: usize> Penalized<'a, D> {
             let trial: Vec<f64> = weights
                 .iter()
                 .zip(&raise)
-                .map(|(w, r)| if *r { (w * LOCAL_FACTOR).min(1.0) } else { *w })
+                .map(|(w, r)| {
+                    if *r {
+                        (w * LOCAL_FACTOR).min(self.unit)
+                    } else {
+                        *w
+                    }
+                })
                 .collect();
-            let trial_y = self.minimiser(|i| trial[i])?;
+            let trial_y = self.minimiser(|i| trial[i], false)?;
             if self.energy_at(&trial_y, anchor_energy) > cap {
                 break;
             }
@@ -277,6 +402,24 @@ impl<'a, const D: usize> Penalized<'a, D> {
         let raised = weights.iter().filter(|w| **w > mu).count();
         Ok((weights, raised))
     }
+}
+
+/// The place of `(r, c)` in a band row of width `2bw + 1`: `c − r + bw`, wrapped by `dim`.
+fn offset(r: usize, c: usize, dim: usize, bw: usize) -> usize {
+    let o = c as isize - r as isize;
+    let o = if o < -(bw as isize) {
+        o + dim as isize
+    } else if o > bw as isize {
+        o - dim as isize
+    } else {
+        o
+    };
+    (o + bw as isize) as usize
+}
+
+/// `v · I`.
+fn identity<const D: usize>(v: f64) -> [[f64; D]; D] {
+    std::array::from_fn(|a| std::array::from_fn(|c| if a == c { v } else { 0.0 }))
 }
 
 /// Windowed sums of the free points' residuals in O(1) each, from prefix sums.

@@ -106,6 +106,33 @@ fn unit_chord<const D: usize>(a: &[f64; D], b: &[f64; D]) -> [f64; D] {
     tau
 }
 
+/// `w · M` for a window whose tangent is the chord from `a` to `b`.
+fn window_metric<const D: usize>(
+    metric: Metric,
+    w: f64,
+    a: &[f64; D],
+    b: &[f64; D],
+) -> [[f64; D]; D] {
+    let mut m = [[0.0; D]; D];
+    match metric {
+        Metric::Jerk => {
+            for (k, row) in m.iter_mut().enumerate() {
+                row[k] = w;
+            }
+        }
+        Metric::MinVariation { eps, .. } => {
+            let tau = unit_chord(a, b);
+            for k in 0..D {
+                for l in 0..D {
+                    let id = if k == l { 1.0 } else { 0.0 };
+                    m[k][l] = w * (id - tau[k] * tau[l] + eps * id);
+                }
+            }
+        }
+    }
+    m
+}
+
 /// The speed term of the minimum-variation metric: for every three consecutive points, the
 /// second divided difference `Δ²_j` (`≈ C''/2`) weighed across nothing but the unit chord
 /// `τ_j = (q_{j+2} − q_j)/|…|` of `shape`, `w_j · speed · (τ_jᵀ Δ²_j)²`. For a curve at speed
@@ -185,27 +212,10 @@ impl<const D: usize> Energy<D> {
                 let ts = [param(j), param(j + 1), param(j + 2), param(j + 3)];
                 let coef = divided_difference(ts);
                 let w = ts[3] - ts[0];
-                let mut m = [[0.0; D]; D];
-                match metric {
-                    Metric::Jerk => {
-                        for (a, row) in m.iter_mut().enumerate() {
-                            row[a] = w;
-                        }
-                    }
-                    Metric::MinVariation { eps, .. } => {
-                        let tau = unit_chord(&shape[j], &shape[(j + 3) % n]);
-                        for a in 0..D {
-                            for b in 0..D {
-                                let id = if a == b { 1.0 } else { 0.0 };
-                                m[a][b] = w * (id - tau[a] * tau[b] + eps * id);
-                            }
-                        }
-                    }
-                }
                 Window {
                     first: j,
                     coef,
-                    metric: m,
+                    metric: window_metric(metric, w, &shape[j], &shape[(j + 3) % n]),
                 }
             })
             .collect();
@@ -214,6 +224,35 @@ impl<const D: usize> Energy<D> {
         {
             windows.extend(speed_windows(n, closed, &param, shape, speed));
         }
+        Energy { n, closed, windows }
+    }
+
+    /// The energy of a cubic B-spline with control points `ctrl` (`≈ ∫ |C'''|² dt / 12`, as
+    /// the point form: its windows overlap three times). `spans` gives, for each knot span,
+    /// its first control point, the coefficients of `C'''/6` on its four control points and
+    /// its length; the metric's tangent on a span is the chord from its first to its last
+    /// control point. The whole is multiplied by `unit`.
+    pub fn spline(
+        ctrl: &[[f64; D]],
+        closed: bool,
+        spans: &[(usize, [f64; 4], f64)],
+        unit: f64,
+        metric: Metric,
+    ) -> Energy<D> {
+        let n = ctrl.len();
+        let windows = spans
+            .iter()
+            .map(|&(first, coef, len)| Window {
+                first,
+                coef,
+                metric: window_metric(
+                    metric,
+                    3.0 * len * unit,
+                    &ctrl[first],
+                    &ctrl[(first + 3) % n],
+                ),
+            })
+            .collect();
         Energy { n, closed, windows }
     }
 

@@ -45,9 +45,12 @@
 //! points on the band's edge.
 
 mod debias;
+mod design;
 mod energy;
+mod form;
 mod params;
 mod solver;
+mod spline;
 
 #[cfg(test)]
 mod reference_tests;
@@ -63,6 +66,7 @@ use crate::geom::{Point, PointSeq};
 
 use debias::{ENERGY_CAP, Penalized};
 use energy::{Energy, Metric};
+use form::Form;
 use params::{BandParams, PARAMS};
 pub use params::{DEFAULT_EPS, DEFAULT_MAX_ITERATIONS, DEFAULT_PASSES};
 use solver::{Problem, solve};
@@ -77,6 +81,9 @@ const PARAMETER_WINDOW_TOLERANCES: f64 = 4.0;
 /// The fewest points of a closed curve (the cyclic band of the Newton matrix must not wrap
 /// onto itself).
 const MIN_CLOSED_POINTS: usize = 8;
+
+/// Rounds of re-measuring the spacing for the parameter window of dense points.
+const DENSE_WINDOW_ROUNDS: usize = 8;
 
 /// Shortenings [`into_band`] tries before it leaves a point where it was (the cut doubles each
 /// time, so 64 reach any scale).
@@ -184,6 +191,13 @@ impl FairMethod for Band {
             })
             .into_iter()
             .collect();
+        if let Some(vars) = faired.spline {
+            notes.push(format!(
+                "dense points: solved in the spline form, a cubic B-spline with {vars} control \
+                 points through which every point is taken (see docs/algorithms/band.md, \
+                 Dense points)"
+            ));
+        }
         if let Some(gap) = faired.stalled {
             notes.push(format!(
                 "the solver stopped short of its stopping rule: rounding stopped its progress at \
@@ -240,8 +254,14 @@ struct Faired<const D: usize> {
     /// The data weight of the debiasing stage, when it ran, and the number of points whose
     /// weight was raised locally.
     fidelity: Option<(f64, usize)>,
+    /// The number of control points when the spline form ran.
+    spline: Option<usize>,
     solver: SolverInfo,
 }
+
+/// Above this many points the spline form is tried (`spline.rs`): the point form's solver
+/// stalls from a few thousand points on (see `docs/algorithms/band.md`, Limits).
+pub const DENSE_POINTS: usize = 2000;
 
 /// Run the passes on points of any dimension and put the result into the band exactly.
 fn fair_points<const D: usize>(
@@ -261,22 +281,31 @@ fn fair_points<const D: usize>(
             centre[a] += p[a] / n as f64;
         }
     }
-    let scaled: Vec<f64> = pts
-        .iter()
-        .flat_map(|p| (0..D).map(move |a| (p[a] - centre[a]) / tolerance))
-        .collect();
+    let scale =
+        |p: &[f64; D]| -> [f64; D] { std::array::from_fn(|a| (p[a] - centre[a]) / tolerance) };
+    let scaled: Vec<f64> = pts.iter().flat_map(scale).collect();
+    let held_ends = held.iter().take_while(|h| **h).count();
+    let dense = n > DENSE_POINTS && held_ends <= 1;
     // The first pass's reference and parameters: the input, averaged where the noise is as
     // large as the spacing.
-    let mut shape: Vec<[f64; D]> = smoothed_for_parameters(pts, closed, tolerance);
+    let mut shape: Vec<[f64; D]> = if dense {
+        moving_average(pts, closed, dense_parameter_window(pts, closed, tolerance))
+    } else {
+        smoothed_for_parameters(pts, closed, tolerance)
+    };
     // Every pass keeps the first pass's parameters. A faired result keeps the tangential
     // part of the noise (the band lets points slide along the curve, and the minimum-variation
     // energy hardly weighs it), so its own chords are noisy where the noise is as large as the
     // spacing: on the tuning set, re-taking them gave 170 spurious inflections against 71.
     let chords = energy::chords_of(&shape, closed);
-    let mut reference: Vec<f64> = shape
-        .iter()
-        .flat_map(|p| (0..D).map(move |a| (p[a] - centre[a]) / tolerance))
-        .collect();
+    let spline = if dense {
+        Form::spline(&chords, tolerance, &scaled, closed, held_ends == 1)?
+    } else {
+        None
+    };
+    let spline_form = spline.is_some();
+    let form = spline.unwrap_or_else(|| Form::points(held, chords, closed));
+    let mut reference = form.first_reference(shape.iter().flat_map(scale).collect());
     let mut history = Vec::with_capacity(params.passes);
     let mut iterations = 0;
     let mut converged = true;
@@ -300,19 +329,29 @@ fn fair_points<const D: usize>(
         });
     };
     for pass in 0..params.passes {
-        let energy = Energy::build_with_chords(&chords, &shape, closed, pass_metric(pass, params));
-        let problem = band_problem(&energy, &reference, &scaled, held, params.max_iterations);
+        let energy = form.energy(&shape, &reference, pass_metric(pass, params));
+        let problem = band_problem(&form, &energy, &reference, &scaled, params.max_iterations);
         let sol = solve(&problem)?;
         record(&sol, pass + 1, &mut shape);
-        reference = scaled.iter().zip(&sol.r).map(|(a, r)| a + r).collect();
+        reference = form.next_reference(&reference, &scaled, &sol);
     }
     let mut fidelity = None;
     if params.fit > 0.0 && noise_sigma > 0.0 {
         // The last pass's metric, its tangents re-taken from the passes' result.
         let metric = pass_metric(params.passes - 1, params);
-        let energy = Energy::build_with_chords(&chords, &shape, closed, metric);
-        let mut problem = band_problem(&energy, &reference, &scaled, held, params.max_iterations);
-        let fit = Penalized::new(&energy, held, &problem.anchor, &problem.centres);
+        let energy = form.energy(&shape, &reference, metric);
+        let mut problem = band_problem(&form, &energy, &reference, &scaled, params.max_iterations);
+        let fixed = form.fixed(&problem.centres);
+        let fit = Penalized::new(
+            &energy,
+            form.unit(),
+            &form.design,
+            &form.held,
+            &form.pinned,
+            &fixed,
+            &problem.anchor,
+            &problem.centres,
+        );
         let scaled_noise = params.fit * noise_sigma / tolerance;
         let target = D as f64 * scaled_noise * scaled_noise;
         let anchor_energy = problem.anchor_energy;
@@ -328,7 +367,8 @@ fn fair_points<const D: usize>(
             problem.fidelity = weights;
             let sol = solve(&problem)?;
             record(&sol, params.passes + 1, &mut shape);
-            fidelity = Some((mu, raised));
+            // Reported in the point form's units.
+            fidelity = Some((mu / form.unit(), raised));
         }
     }
     let on_edge = shape
@@ -342,6 +382,7 @@ fn fair_points<const D: usize>(
         stalled,
         history,
         fidelity,
+        spline: spline_form.then(|| form.vars()),
         solver: SolverInfo {
             iterations,
             duality_gap: gap,
@@ -359,23 +400,32 @@ fn pass_metric(pass: usize, params: &BandParams) -> Metric {
     }
 }
 
-/// The band problem with the energy `energy` taken relative to `reference` (both in units of
-/// the tolerance, flat, like the input `scaled`), without a data term.
+/// The band problem of `form` with the energy `energy` taken relative to `reference` (its
+/// unknowns, in units of the tolerance, flat; the input `scaled` likewise), without a data
+/// term.
 fn band_problem<'a, const D: usize>(
+    form: &'a Form<D>,
     energy: &'a Energy<D>,
     reference: &[f64],
     scaled: &[f64],
-    held: &'a [bool],
     max_iterations: usize,
 ) -> Problem<'a, D> {
     let mut anchor = vec![0.0; reference.len()];
     energy.apply_add(reference, &mut anchor);
+    let mut centres = vec![0.0; scaled.len()];
+    form.design.eval::<D>(reference, &mut centres);
+    for (c, a) in centres.iter_mut().zip(scaled) {
+        *c = a - *c;
+    }
     Problem {
         energy,
         anchor,
         anchor_energy: energy.value(reference),
-        centres: scaled.iter().zip(reference).map(|(a, s)| a - s).collect(),
-        held,
+        design: &form.design,
+        centres,
+        held: &form.held,
+        pinned: &form.pinned,
+        start: form.start(reference),
         max_iterations,
         fidelity: Vec::new(),
     }
@@ -403,6 +453,66 @@ fn parameter_window<const D: usize>(pts: &[[f64; D]], tolerance: f64) -> usize {
     } else {
         0
     }
+}
+
+/// The half-width of the parameter window for dense points: as [`parameter_window`], but with
+/// the spacing re-measured on the averaged points until the window stops growing. Where the
+/// noise is much larger than the spacing the input's median chord is noise, and a window set by
+/// it leaves the averaged chords noisy too.
+fn dense_parameter_window<const D: usize>(pts: &[[f64; D]], closed: bool, tolerance: f64) -> usize {
+    let n = pts.len();
+    let mut m = parameter_window(pts, tolerance);
+    for _ in 0..DENSE_WINDOW_ROUNDS {
+        let s = moving_average(pts, closed, m);
+        let mut chords: Vec<f64> = (0..n - 1).map(|i| distance(&s[i], &s[i + 1])).collect();
+        let mid = chords.len() / 2;
+        let h = *chords.select_nth_unstable_by(mid, f64::total_cmp).1;
+        if h <= 0.0 {
+            break;
+        }
+        let want = ((PARAMETER_WINDOW_TOLERANCES * tolerance / h).floor() as usize).min(n / 8);
+        if want <= m {
+            break;
+        }
+        m = want;
+    }
+    m
+}
+
+/// The input averaged over a moving window of `2m + 1` points (cyclic when closed; near the
+/// ends of an open curve a symmetric window, so the ends are not pulled inwards), by prefix
+/// sums: O(n) whatever `m` (at most an eighth of the points).
+fn moving_average<const D: usize>(pts: &[[f64; D]], closed: bool, m: usize) -> Vec<[f64; D]> {
+    let n = pts.len();
+    if m == 0 {
+        return pts.to_vec();
+    }
+    // prefix[j] = the sum of the first j points of the input, padded cyclically by m on each
+    // side when closed.
+    let pad = if closed { m } else { 0 };
+    let mut prefix = vec![[0.0; D]; n + 2 * pad + 1];
+    for j in 0..n + 2 * pad {
+        let p = &pts[(j + n - pad) % n];
+        for a in 0..D {
+            prefix[j + 1][a] = prefix[j][a] + p[a];
+        }
+    }
+    (0..n)
+        .map(|i| {
+            let (lo, hi) = if closed {
+                (i, i + 2 * m)
+            } else {
+                let half = i.min(n - 1 - i).min(m);
+                (i - half, i + half)
+            };
+            let count = (hi - lo + 1) as f64;
+            let mut acc = [0.0; D];
+            for a in 0..D {
+                acc[a] = (prefix[hi + 1][a] - prefix[lo][a]) / count;
+            }
+            acc
+        })
+        .collect()
 }
 
 /// The points whose chord lengths give the first pass its parameters: the input, averaged

@@ -12,6 +12,7 @@ use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
 };
 
+use super::design::Design;
 use super::energy::{Energy, Metric};
 use super::solver::{Problem, solve};
 
@@ -50,7 +51,9 @@ fn noisy_wave(n: usize, closed: bool, noise: f64) -> (Vec<[f64; 2]>, Vec<[f64; 2
 /// digits away and Clarabel stops percents above the optimum.
 fn clarabel_objective(energy: &Energy<2>, problem: &Problem<'_, 2>, s: &[f64]) -> f64 {
     let (c, held) = (&problem.centres, problem.held);
+    // Unknowns: `n` (control) points.
     let n = energy.n;
+    let fixed = problem.start.clone().unwrap_or_else(|| c.clone());
     let nw = energy.windows.len();
     let dim = 2 * n + 2 * nw;
     // The objective scaled to order one (Clarabel's tolerances are absolute below one).
@@ -104,19 +107,29 @@ fn clarabel_objective(energy: &Energy<2>, problem: &Problem<'_, 2>, s: &[f64]) -
             ar.push(row);
             ac.push(2 * i + k);
             av.push(1.0);
-            b.push(c[2 * i + k]);
+            b.push(fixed[2 * i + k]);
             row += 1;
         }
     }
     cones.push(SupportedConeT::ZeroConeT(row));
-    // Free points: (1, y_i − c_i) ∈ SOC(3), as A x + s = b with A = [0; −I], b = [1; −c_i].
-    for i in (0..n).filter(|i| !held[*i]) {
+    // Free points: (1, (B y)_i − c_i) ∈ SOC(3), as A x + s = b with A = [0; −B_i],
+    // b = [1; −c_i].
+    let points = problem.pinned.len();
+    for i in (0..points).filter(|i| !problem.pinned[*i]) {
         b.push(1.0);
         row += 1;
+        let terms: Vec<(usize, f64)> = match problem.design {
+            Design::Points { .. } => vec![(i, 1.0)],
+            Design::Spline(m) => (0..4)
+                .map(|k| ((m.first[i] + k) % m.vars, m.basis[i][k]))
+                .collect(),
+        };
         for k in 0..2 {
-            ar.push(row);
-            ac.push(2 * i + k);
-            av.push(-1.0);
+            for (j, v) in &terms {
+                ar.push(row);
+                ac.push(2 * j + k);
+                av.push(-v);
+            }
             b.push(-c[2 * i + k]);
             row += 1;
         }
@@ -222,12 +235,16 @@ fn check(n: usize, closed: bool, metric: Metric, held_per_end: usize) {
     let energy = Energy::build(&pts, closed, metric);
     let mut anchor = vec![0.0; a.len()];
     energy.apply_add(&s, &mut anchor);
+    let design = Design::Points { n };
     let problem = Problem {
         energy: &energy,
         anchor,
         anchor_energy: energy.value(&s),
+        design: &design,
         centres: a.iter().zip(&s).map(|(a, s)| a - s).collect(),
         held: &held,
+        pinned: &held,
+        start: None,
         max_iterations: 500,
         fidelity: Vec::new(),
     };
@@ -289,4 +306,95 @@ fn closed_matches_clarabel() {
         },
         0,
     );
+}
+
+/// The spline form (dense points): the same problem over a cubic B-spline's control points,
+/// every point's band a cone on four of them. Checked against Clarabel and the dual bound's
+/// counterpart is left to the point form (the multipliers' bound needs `B`); here the solver
+/// must converge, keep every point in the band, and be no worse than Clarabel.
+fn check_spline(n: usize, closed: bool, metric: Metric, spans: usize, hold_ends: bool) {
+    use super::spline::{Layout, feasible_fit};
+    let tolerance = 0.03;
+    // Noise a third of the tolerance, as the automatic tolerance has it (`D ≥ 3σ̂`).
+    let (pts, _) = noisy_wave(n, closed, 0.01);
+    let a: Vec<f64> = pts
+        .iter()
+        .flat_map(|p| [p[0] / tolerance, p[1] / tolerance])
+        .collect();
+    let t: Vec<f64> = (0..n).map(|i| i as f64).collect();
+    let layout = Layout::new(&t, closed, n as f64, spans);
+    let vars = layout.design.vars();
+    let mut held = vec![false; vars];
+    let mut pinned = vec![false; n];
+    let mut fixed = vec![0.0; 2 * vars];
+    if hold_ends {
+        held[0] = true;
+        held[vars - 1] = true;
+        pinned[0] = true;
+        pinned[n - 1] = true;
+        fixed[..2].copy_from_slice(&a[..2]);
+        fixed[2 * vars - 2..].copy_from_slice(&a[2 * n - 2..]);
+    }
+    let flat = vec![[0.0; 2]; vars];
+    let unit = layout.energy_unit();
+    let jerk = Energy::spline(&flat, closed, &layout.spans, unit, Metric::Jerk);
+    let fit = feasible_fit(&jerk, &layout, &held, &pinned, &fixed, &a)
+        .expect("fit")
+        .expect("a feasible start");
+    // The reference: the fit, its tangents giving the metric.
+    let ctrl: Vec<[f64; 2]> = fit.chunks(2).map(|c| [c[0], c[1]]).collect();
+    let energy = Energy::spline(&ctrl, closed, &layout.spans, unit, metric);
+    let s = fit.clone();
+    let mut anchor = vec![0.0; s.len()];
+    energy.apply_add(&s, &mut anchor);
+    let mut bs = vec![0.0; a.len()];
+    layout.design.eval::<2>(&s, &mut bs);
+    let problem = Problem {
+        energy: &energy,
+        anchor,
+        anchor_energy: energy.value(&s),
+        design: &layout.design,
+        centres: a.iter().zip(&bs).map(|(a, b)| a - b).collect(),
+        held: &held,
+        pinned: &pinned,
+        start: Some(vec![0.0; s.len()]),
+        max_iterations: 500,
+        fidelity: Vec::new(),
+    };
+    let reference = clarabel_objective(&energy, &problem, &s);
+    let sol = solve(&problem).expect("band solve");
+    assert!(
+        sol.converged,
+        "spline form did not converge (n = {n}, closed = {closed})"
+    );
+    assert!(
+        sol.r.chunks(2).all(|r| r[0] * r[0] + r[1] * r[1] <= 1.0),
+        "spline form left the band"
+    );
+    let ours = sol.objective;
+    assert!(
+        ours <= reference * (1.0 + 1e-6),
+        "n = {n}, closed = {closed}: band {ours:.12e}, clarabel {reference:.12e}"
+    );
+    // Clarabel's optimum is no more than 1e-6 below ours either: the two agree.
+    assert!(
+        ours >= reference * (1.0 - 1e-6),
+        "n = {n}, closed = {closed}: band {ours:.12e} below clarabel {reference:.12e}"
+    );
+}
+
+#[test]
+fn spline_form_matches_clarabel() {
+    check_spline(1500, false, Metric::Jerk, 40, false);
+    check_spline(
+        1200,
+        false,
+        Metric::MinVariation {
+            eps: 0.02,
+            speed: 0.0,
+        },
+        30,
+        true,
+    );
+    check_spline(1600, true, Metric::Jerk, 48, false);
 }

@@ -35,6 +35,7 @@
 //! quadratics in t) are floored by static regularisation and the solve is corrected by a step
 //! of iterative refinement against the true matrix.
 
+use super::design::Design;
 use super::energy::Energy;
 use crate::error::{Error, Result};
 use crate::numeric::{CyclicSymBanded, SymBanded};
@@ -83,10 +84,18 @@ pub(super) struct Problem<'a, const D: usize> {
     pub anchor: Vec<f64>,
     /// `E(s)`.
     pub anchor_energy: f64,
-    /// The ball centres `c = a − s`, flat.
+    /// How the unknowns give the points (`B`; the identity in the point form).
+    pub design: &'a Design,
+    /// The ball centres `c = a − B s`, flat, one per point.
     pub centres: Vec<f64>,
-    /// Points that may not move.
+    /// Unknowns that may not move (points in the point form, control points in the spline
+    /// form).
     pub held: &'a [bool],
+    /// Points without a band constraint: the held points, which sit on their input points.
+    pub pinned: &'a [bool],
+    /// A strictly feasible start (unknowns relative to the reference, held ones at their
+    /// values); `None` in the point form, which moves each point into its ball.
+    pub start: Option<Vec<f64>>,
     /// Newton steps allowed.
     pub max_iterations: usize,
     /// Weights `μ_i` of the data term `Σ μ_i |y_i − c_i|²` added to the objective, one per
@@ -97,9 +106,11 @@ pub(super) struct Problem<'a, const D: usize> {
 /// What [`solve`] found.
 #[derive(Clone, Debug)]
 pub(super) struct Solution {
-    /// Displacements from the input, `y − c`, in units of the tolerance, flat (`D` numbers a
+    /// Displacements from the input, `B y − c`, in units of the tolerance, flat (`D` numbers a
     /// point).
     pub r: Vec<f64>,
+    /// The unknowns relative to the reference, `y`.
+    pub y: Vec<f64>,
     /// The objective `f(r)`.
     pub objective: f64,
     /// Newton steps taken.
@@ -122,6 +133,7 @@ enum Newton {
 
 impl Newton {
     fn new<const D: usize>(energy: &Energy<D>, held: &[bool]) -> Newton {
+        // `held` is per unknown.
         let dim = energy.n * D;
         let bw = 4 * D - 1;
         if energy.closed {
@@ -142,27 +154,23 @@ impl Newton {
         Newton::Open { base, work }
     }
 
-    /// Assemble `2A + blocks` (`blocks[i]` the D×D block of point i) and factorise it.
+    /// Assemble `2A + Bᵀ blocks B` (`blocks[i]` the D×D block of point i) and factorise it.
     fn factorize<const D: usize>(
         &mut self,
-        energy: &Energy<D>,
+        p: &Problem<'_, D>,
         blocks: &[[[f64; D]; D]],
-        held: &[bool],
     ) -> Result<()> {
+        let (energy, held) = (p.energy, p.held);
         match self {
             Newton::Open { base, work } => {
                 work.assign(base);
                 let mut top = 0.0_f64;
-                for (i, b) in blocks.iter().enumerate() {
-                    if held[i] {
-                        continue;
-                    }
-                    for a in 0..D {
-                        for c in 0..=a {
-                            work.add(i * D + a, i * D + c, b[a][c]);
+                p.design
+                    .for_each_block_lower::<D>(blocks, p.pinned, |r, c, v| {
+                        if !held[r / D] && !held[c / D] {
+                            work.add(r, c, v);
                         }
-                    }
-                }
+                    });
                 for k in 0..work.n() {
                     top = top.max(work.get(k, k));
                 }
@@ -173,13 +181,10 @@ impl Newton {
                 let mut m = CyclicSymBanded::zeros(dim, 4 * D - 1);
                 energy.for_each_lower(2.0, |r, c, v| m.add(r, c, v));
                 let mut top = 0.0_f64;
-                for (i, b) in blocks.iter().enumerate() {
-                    for a in 0..D {
-                        for c in 0..=a {
-                            m.add(i * D + a, i * D + c, b[a][c]);
-                        }
-                        top = top.max(m.get(i * D + a, i * D + a));
-                    }
+                p.design
+                    .for_each_block_lower::<D>(blocks, p.pinned, |r, c, v| m.add(r, c, v));
+                for k in 0..dim {
+                    top = top.max(m.get(k, k));
                 }
                 for k in 0..dim {
                     m.add(k, k, REGULARIZATION_REL * top);
@@ -205,28 +210,25 @@ impl Newton {
     }
 }
 
-/// `out = K v` for the true Newton matrix `K = 2A + blocks` (held rows: the identity).
+/// `out = K v` for the true Newton matrix `K = 2A + Bᵀ blocks B` (held rows: the identity);
+/// `work` is a point-sized buffer.
 fn newton_apply<const D: usize>(
-    energy: &Energy<D>,
+    p: &Problem<'_, D>,
     blocks: &[[[f64; D]; D]],
-    held: &[bool],
     v: &[f64],
+    work: &mut [f64],
     out: &mut [f64],
 ) {
     out.fill(0.0);
-    energy.apply_add(v, out);
+    p.energy.apply_add(v, out);
     for o in out.iter_mut() {
         *o *= 2.0;
     }
-    for (i, b) in blocks.iter().enumerate() {
-        if held[i] {
-            for a in 0..D {
-                out[i * D + a] = v[i * D + a];
-            }
-            continue;
-        }
-        for a in 0..D {
-            out[i * D + a] += (0..D).map(|c| b[a][c] * v[i * D + c]).sum::<f64>();
+    p.design
+        .apply_blocks_add::<D>(blocks, p.pinned, v, work, out);
+    for (k, o) in out.iter_mut().enumerate() {
+        if p.held[k / D] {
+            *o = v[k];
         }
     }
 }
@@ -264,14 +266,14 @@ fn start<const D: usize>(centres: &[f64], held: &[bool]) -> Vec<f64> {
 
 /// Whether the step `α Δy` keeps every free point strictly inside the band, with at least
 /// `1 − STEP_TO_BOUNDARY` of its slack.
-fn inside<const D: usize>(st: &State<D>, dy: &[f64], alpha: f64, held: &[bool]) -> bool {
-    (0..held.len()).all(|i| {
-        if held[i] {
+fn inside<const D: usize>(st: &State<D>, dr: &[f64], alpha: f64, pinned: &[bool]) -> bool {
+    (0..pinned.len()).all(|i| {
+        if pinned[i] {
             return true;
         }
         let mut trial = [0.0; D];
         for a in 0..D {
-            trial[a] = st.off[i * D + a] + alpha * dy[i * D + a];
+            trial[a] = st.off[i * D + a] + alpha * dr[i * D + a];
         }
         -constraint(&trial) >= SLACK_KEPT * st.sig[i]
     })
@@ -298,7 +300,7 @@ fn step_length(lam: &[f64], dlam: &[f64], sig: &[f64], dsig: &[f64], held: &[boo
 /// The working arrays of one run.
 struct State<const D: usize> {
     y: Vec<f64>,
-    /// `y − c`: the displacement from the input point, in tolerances.
+    /// `B y − c`: the displacement from the input point, in tolerances.
     off: Vec<f64>,
     lam: Vec<f64>,
     /// The slacks `σ_i = −h_i` at feasibility, kept as variables so that a point close to the
@@ -313,25 +315,40 @@ struct State<const D: usize> {
 /// finite input).
 pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
     let energy = p.energy;
-    let n = energy.n;
-    let dim = n * D;
-    let held = p.held;
-    let free = held.iter().filter(|h| !**h).count();
-    let y = start::<D>(&p.centres, held);
-    let off: Vec<f64> = y.iter().zip(&p.centres).map(|(a, b)| a - b).collect();
+    let design = p.design;
+    // `n` points (constraints), `dim` unknowns.
+    let n = design.points();
+    let dim = design.vars() * D;
+    let (held, pinned) = (p.held, p.pinned);
+    let free = pinned.iter().filter(|h| !**h).count();
+    let y = match &p.start {
+        Some(y) => y.clone(),
+        None => start::<D>(&p.centres, pinned),
+    };
+    let mut off = vec![0.0; n * D];
+    design.eval::<D>(&y, &mut off);
+    for (o, c) in off.iter_mut().zip(&p.centres) {
+        *o -= c;
+    }
     let sig: Vec<f64> = (0..n)
         .map(|i| {
-            if held[i] {
+            if pinned[i] {
                 1.0
             } else {
                 -constraint(&off[i * D..(i + 1) * D])
             }
         })
         .collect();
+    if sig.iter().any(|s| *s <= 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "band".into(),
+            reason: "the solver's start is not strictly inside the band".into(),
+        });
+    }
     let mut st = State::<D> {
         y,
         off,
-        lam: held.iter().map(|h| if *h { 0.0 } else { 1.0 }).collect(),
+        lam: pinned.iter().map(|h| if *h { 0.0 } else { 1.0 }).collect(),
         sig,
     };
     let mut newton = Newton::new(energy, held);
@@ -353,20 +370,25 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
     let mut rc = vec![0.0; n];
     let mut rp = vec![0.0; n];
     let mut dy = vec![0.0; dim];
+    let mut dr = vec![0.0; n * D];
     let mut dlam = vec![0.0; n];
     let mut dsig = vec![0.0; n];
-    let mut work = vec![0.0; dim];
-    let mut rhs = vec![0.0; dim];
+    let mut work = Work {
+        vars: vec![0.0; dim],
+        points: vec![0.0; n * D],
+        rhs: vec![0.0; dim],
+    };
+    // The constraint and data terms of the dual residual, per point.
+    let mut pull = vec![0.0; n * D];
 
     let weight = |i: usize| p.fidelity.get(i).copied().unwrap_or(0.0);
-    let objective = |y: &[f64], ay: &[f64]| -> f64 {
+    let objective = |y: &[f64], ay: &[f64], off: &[f64]| -> f64 {
         let quad: f64 = y.iter().zip(ay).map(|(x, v)| x * v).sum();
         let lin: f64 = y.iter().zip(&p.anchor).map(|(x, v)| x * v).sum();
-        let data: f64 = y
+        let data: f64 = off
             .iter()
-            .zip(&p.centres)
             .enumerate()
-            .map(|(k, (x, c))| weight(k / D) * (x - c) * (x - c))
+            .map(|(k, r)| weight(k / D) * r * r)
             .sum();
         p.anchor_energy + 2.0 * lin + quad + data
     };
@@ -385,9 +407,9 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
         }
         let mut gap = 0.0;
         for i in 0..n {
-            if held[i] {
+            if pinned[i] {
                 for a in 0..D {
-                    rd[i * D + a] = 0.0;
+                    pull[i * D + a] = 0.0;
                 }
                 continue;
             }
@@ -397,10 +419,17 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
             gap += st.lam[i] * st.sig[i];
             for a in 0..D {
                 let k = i * D + a;
-                rd[k] = grad[k] + 2.0 * (st.lam[i] + weight(i)) * st.off[k];
+                pull[k] = 2.0 * (st.lam[i] + weight(i)) * st.off[k];
             }
         }
-        let f = objective(&st.y, &ay);
+        rd.copy_from_slice(&grad);
+        design.eval_t_add::<D>(&pull, &mut rd);
+        for (k, r) in rd.iter_mut().enumerate() {
+            if held[k / D] {
+                *r = 0.0;
+            }
+        }
+        let f = objective(&st.y, &ay, &st.off);
         let scale = f.abs().max(OBJECTIVE_FLOOR * free as f64);
         last_gap = gap / scale;
         // The dual residual is measured against the size of the terms that make it up
@@ -424,7 +453,7 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
         // both the predictor and the corrector.
         for i in 0..n {
             blocks[i] = [[0.0; D]; D];
-            if held[i] {
+            if pinned[i] {
                 continue;
             }
             let w = 4.0 * st.lam[i] / st.sig[i];
@@ -442,27 +471,36 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
         // The iterate is strictly feasible at every step: if rounding makes the Newton system
         // unusable (a non-finite pivot or direction, possible only near the end when many
         // multipliers and slacks are both tiny), the run stops there with what it has.
-        if newton.factorize(energy, &blocks, held).is_err() {
+        if newton.factorize(p, &blocks).is_err() {
             break;
         }
 
         // Predictor (affine scaling): complementarity target 0, constraint target 0.
         for i in 0..n {
-            rc[i] = if held[i] { 0.0 } else { st.lam[i] * st.sig[i] };
+            rc[i] = if pinned[i] {
+                0.0
+            } else {
+                st.lam[i] * st.sig[i]
+            };
         }
         rp.fill(0.0);
+        let mut step = Step {
+            dy: &mut dy,
+            dr: &mut dr,
+            dlam: &mut dlam,
+            dsig: &mut dsig,
+        };
         if direction(
-            p, &newton, &blocks, &st, &rd, &rp, &rc, &mut dy, &mut dlam, &mut dsig, &mut rhs,
-            &mut work,
+            p, &newton, &blocks, &st, &rd, &rp, &rc, &mut step, &mut work,
         )
         .is_err()
         {
             break;
         }
-        let alpha_aff = step_length(&st.lam, &dlam, &st.sig, &dsig, held);
+        let alpha_aff = step_length(&st.lam, &dlam, &st.sig, &dsig, pinned);
         let mut gap_aff = 0.0;
         for i in 0..n {
-            if !held[i] {
+            if !pinned[i] {
                 gap_aff += (st.lam[i] + alpha_aff * dlam[i]) * (st.sig[i] + alpha_aff * dsig[i]);
             }
         }
@@ -473,29 +511,34 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
         // which is what a point sliding along the band's edge loses to the curvature of the
         // edge (without it such a step leaves the band and is cut short).
         for i in 0..n {
-            if held[i] {
+            if pinned[i] {
                 rc[i] = 0.0;
                 rp[i] = 0.0;
                 continue;
             }
             rc[i] = st.lam[i] * st.sig[i] + dlam[i] * dsig[i] - centring * mu;
-            let slide: f64 = (0..D).map(|a| dy[i * D + a] * dy[i * D + a]).sum();
+            let slide: f64 = (0..D).map(|a| dr[i * D + a] * dr[i * D + a]).sum();
             rp[i] = alpha_aff * slide;
         }
+        let mut step = Step {
+            dy: &mut dy,
+            dr: &mut dr,
+            dlam: &mut dlam,
+            dsig: &mut dsig,
+        };
         if direction(
-            p, &newton, &blocks, &st, &rd, &rp, &rc, &mut dy, &mut dlam, &mut dsig, &mut rhs,
-            &mut work,
+            p, &newton, &blocks, &st, &rd, &rp, &rc, &mut step, &mut work,
         )
         .is_err()
         {
             break;
         }
-        let mut alpha = step_length(&st.lam, &dlam, &st.sig, &dsig, held);
+        let mut alpha = step_length(&st.lam, &dlam, &st.sig, &dsig, pinned);
         // The constraints are curved: a point sliding along the band's edge leaves it at
         // second order. Shorten the step until every point keeps at least a fraction of its
         // slack (the same rule as the step to the boundary of the linearised slack).
         let mut tries = 0;
-        while tries < MAX_BACKTRACKS && !inside(&st, &dy, alpha, held) {
+        while tries < MAX_BACKTRACKS && !inside(&st, &dr, alpha, pinned) {
             alpha *= BACKTRACK;
             tries += 1;
         }
@@ -512,10 +555,12 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
         }
         for k in 0..dim {
             st.y[k] += alpha * dy[k];
-            st.off[k] += alpha * dy[k];
+        }
+        for (o, d) in st.off.iter_mut().zip(&dr) {
+            *o += alpha * d;
         }
         for i in 0..n {
-            if !held[i] {
+            if !pinned[i] {
                 st.lam[i] += alpha * dlam[i];
                 st.sig[i] += alpha * dsig[i];
             }
@@ -526,9 +571,15 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
     converged |= last_gap <= ACCEPT_GAP_REL;
     ay.fill(0.0);
     energy.apply_add(&st.y, &mut ay);
-    let objective = objective(&st.y, &ay);
+    // Pinned points sit on their input points by definition; in the spline form the
+    // displacement accumulated over the steps can carry rounding (1e-13 tolerances seen).
+    for (i, _) in pinned.iter().enumerate().filter(|(_, p)| **p) {
+        st.off[i * D..(i + 1) * D].fill(0.0);
+    }
+    let objective = objective(&st.y, &ay, &st.off);
     Ok(Solution {
         r: st.off,
+        y: st.y,
         objective,
         iterations,
         gap: last_gap,
@@ -537,11 +588,27 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
     })
 }
 
+/// A direction: the unknowns' `Δy`, the points' `Δr = B Δy`, and the multipliers' and
+/// slacks' steps.
+struct Step<'s> {
+    dy: &'s mut [f64],
+    dr: &'s mut [f64],
+    dlam: &'s mut [f64],
+    dsig: &'s mut [f64],
+}
+
+/// Scratch buffers of [`direction`].
+struct Work {
+    vars: Vec<f64>,
+    points: Vec<f64>,
+    rhs: Vec<f64>,
+}
+
 /// One Newton direction for the complementarity residual `rc` (`λ_i σ_i` minus its target):
 ///
 /// ```text
-/// K Δy = −r_d − Σ_i 2 r_i (λ_i r_p,i − r_c,i) / σ_i
-/// Δλ_i = (λ_i / σ_i) 2 r_i·Δy + (λ_i r_p,i − r_c,i) / σ_i
+/// K Δy = −r_d − Bᵀ [2 r_i (λ_i r_p,i − r_c,i) / σ_i]_i
+/// Δλ_i = (λ_i / σ_i) 2 r_i·(B Δy)_i + (λ_i r_p,i − r_c,i) / σ_i
 /// Δσ_i = (−r_c,i − σ_i Δλ_i) / λ_i
 /// ```
 ///
@@ -555,50 +622,58 @@ fn direction<const D: usize>(
     rd: &[f64],
     rp: &[f64],
     rc: &[f64],
-    dy: &mut [f64],
-    dlam: &mut [f64],
-    dsig: &mut [f64],
-    rhs: &mut [f64],
-    work: &mut [f64],
+    step: &mut Step<'_>,
+    work: &mut Work,
 ) -> Result<()> {
-    let held = p.held;
-    let n = held.len();
+    let (held, pinned) = (p.held, p.pinned);
+    let n = pinned.len();
     for i in 0..n {
-        if held[i] {
-            for a in 0..D {
-                rhs[i * D + a] = 0.0;
-            }
-            continue;
-        }
-        let t = (st.lam[i] * rp[i] - rc[i]) / st.sig[i];
+        let t = if pinned[i] {
+            0.0
+        } else {
+            (st.lam[i] * rp[i] - rc[i]) / st.sig[i]
+        };
         for a in 0..D {
             let k = i * D + a;
-            rhs[k] = -rd[k] - 2.0 * st.off[k] * t;
+            work.points[k] = -2.0 * st.off[k] * t;
         }
     }
+    let rhs = &mut work.rhs;
+    for (r, d) in rhs.iter_mut().zip(rd) {
+        *r = -d;
+    }
+    p.design.eval_t_add::<D>(&work.points, rhs);
+    for (k, r) in rhs.iter_mut().enumerate() {
+        if held[k / D] {
+            *r = 0.0;
+        }
+    }
+    let dy = &mut *step.dy;
     dy.copy_from_slice(rhs);
     newton.solve(dy)?;
     let rhs_size = norm_inf(rhs).max(f64::MIN_POSITIVE);
     for _ in 0..MAX_REFINEMENTS {
-        newton_apply(p.energy, blocks, held, dy, work);
+        newton_apply(p, blocks, dy, &mut work.points, &mut work.vars);
         for k in 0..dy.len() {
-            work[k] = rhs[k] - work[k];
+            work.vars[k] = rhs[k] - work.vars[k];
         }
-        if norm_inf(work) <= REFINEMENT_REL * rhs_size {
+        if norm_inf(&work.vars) <= REFINEMENT_REL * rhs_size {
             break;
         }
-        newton.solve(work)?;
+        newton.solve(&mut work.vars)?;
         for k in 0..dy.len() {
-            dy[k] += work[k];
+            dy[k] += work.vars[k];
         }
     }
+    p.design.eval::<D>(dy, step.dr);
+    let (dr, dlam, dsig) = (&*step.dr, &mut *step.dlam, &mut *step.dsig);
     for i in 0..n {
-        if held[i] {
+        if pinned[i] {
             dlam[i] = 0.0;
             dsig[i] = 0.0;
             continue;
         }
-        let odot: f64 = (0..D).map(|a| st.off[i * D + a] * dy[i * D + a]).sum();
+        let odot: f64 = (0..D).map(|a| st.off[i * D + a] * dr[i * D + a]).sum();
         dlam[i] = (st.lam[i] / st.sig[i]) * 2.0 * odot + (st.lam[i] * rp[i] - rc[i]) / st.sig[i];
         dsig[i] = (-rc[i] - st.sig[i] * dlam[i]) / st.lam[i];
     }

@@ -1,0 +1,197 @@
+//! How the solver's unknowns give the faired points: `q = B x`.
+//!
+//! In the point form (`Design::Points`) the unknowns are the points themselves, `B = I`. In
+//! the spline form (`Design::Spline`, for dense points, see `spline.rs`) they are the control
+//! points of a cubic B-spline and point `i` is `Σ_k b_ik x_{f_i + k}`: four basis values and
+//! four consecutive control points, so every matrix the solver builds keeps the band of the
+//! energy (half-bandwidth `4D − 1` in the interleaved numbering).
+
+/// The map from unknowns to points.
+#[derive(Clone, Debug)]
+pub(super) enum Design {
+    /// The unknowns are the `n` points.
+    Points { n: usize },
+    /// The unknowns are the control points of a cubic B-spline.
+    Spline(SplineMap),
+}
+
+/// Point `i` of a spline: `Σ_k basis[i][k] · x[(first[i] + k) mod vars]`.
+#[derive(Clone, Debug)]
+pub(super) struct SplineMap {
+    /// The number of control points.
+    pub vars: usize,
+    /// The first control point of each point's span.
+    pub first: Vec<usize>,
+    /// The four basis values of each point.
+    pub basis: Vec<[f64; 4]>,
+}
+
+impl Design {
+    /// The number of points.
+    pub fn points(&self) -> usize {
+        match self {
+            Design::Points { n } => *n,
+            Design::Spline(s) => s.first.len(),
+        }
+    }
+
+    /// The number of unknown points (control points in the spline form).
+    pub fn vars(&self) -> usize {
+        match self {
+            Design::Points { n } => *n,
+            Design::Spline(s) => s.vars,
+        }
+    }
+
+    /// `out = B x` (flat, `D` numbers a point).
+    pub fn eval<const D: usize>(&self, x: &[f64], out: &mut [f64]) {
+        match self {
+            Design::Points { .. } => out.copy_from_slice(x),
+            Design::Spline(s) => {
+                for (i, (&f, b)) in s.first.iter().zip(&s.basis).enumerate() {
+                    let mut q = [0.0; D];
+                    if f + 4 <= s.vars {
+                        let x = &x[f * D..(f + 4) * D];
+                        for (k, bk) in b.iter().enumerate() {
+                            for a in 0..D {
+                                q[a] += bk * x[k * D + a];
+                            }
+                        }
+                    } else {
+                        for (k, bk) in b.iter().enumerate() {
+                            let j = (f + k) % s.vars;
+                            for a in 0..D {
+                                q[a] += bk * x[j * D + a];
+                            }
+                        }
+                    }
+                    out[i * D..(i + 1) * D].copy_from_slice(&q);
+                }
+            }
+        }
+    }
+
+    /// `out += Bᵀ r`.
+    pub fn eval_t_add<const D: usize>(&self, r: &[f64], out: &mut [f64]) {
+        match self {
+            Design::Points { .. } => {
+                for (o, v) in out.iter_mut().zip(r) {
+                    *o += v;
+                }
+            }
+            Design::Spline(s) => {
+                for (i, (&f, b)) in s.first.iter().zip(&s.basis).enumerate() {
+                    let r = &r[i * D..(i + 1) * D];
+                    if f + 4 <= s.vars {
+                        let out = &mut out[f * D..(f + 4) * D];
+                        for (k, bk) in b.iter().enumerate() {
+                            for a in 0..D {
+                                out[k * D + a] += bk * r[a];
+                            }
+                        }
+                    } else {
+                        for (k, bk) in b.iter().enumerate() {
+                            let j = (f + k) % s.vars;
+                            for a in 0..D {
+                                out[j * D + a] += bk * r[a];
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Call `add(row, col, value)` for the entries with `row ≥ col` of `Σ_i B_iᵀ M_i B_i`
+    /// (`M_i = blocks[i]`, points with `skip[i]` left out), as the energy reports its own.
+    pub fn for_each_block_lower<const D: usize>(
+        &self,
+        blocks: &[[[f64; D]; D]],
+        skip: &[bool],
+        mut add: impl FnMut(usize, usize, f64),
+    ) {
+        match self {
+            Design::Points { .. } => {
+                for (i, b) in blocks.iter().enumerate() {
+                    if skip[i] {
+                        continue;
+                    }
+                    for a in 0..D {
+                        for c in 0..=a {
+                            add(i * D + a, i * D + c, b[a][c]);
+                        }
+                    }
+                }
+            }
+            Design::Spline(s) => {
+                // The points come in runs on the same span (their parameters increase): each
+                // run's blocks are summed locally and reported once.
+                let mut acc = [[[[0.0; D]; D]; 4]; 4];
+                let mut current = None;
+                let mut flush = |f: usize, acc: &mut [[[[f64; D]; D]; 4]; 4]| {
+                    for (k, row) in acc.iter_mut().enumerate() {
+                        let r0 = ((f + k) % s.vars) * D;
+                        for (l, m) in row.iter_mut().enumerate() {
+                            let c0 = ((f + l) % s.vars) * D;
+                            for (a, m_a) in m.iter_mut().enumerate() {
+                                for (c, v) in m_a.iter_mut().enumerate() {
+                                    if r0 + a >= c0 + c {
+                                        add(r0 + a, c0 + c, *v);
+                                    }
+                                    *v = 0.0;
+                                }
+                            }
+                        }
+                    }
+                };
+                for (i, m) in blocks.iter().enumerate() {
+                    if skip[i] {
+                        continue;
+                    }
+                    let (f, b) = (s.first[i], &s.basis[i]);
+                    if current != Some(f) {
+                        if let Some(g) = current {
+                            flush(g, &mut acc);
+                        }
+                        current = Some(f);
+                    }
+                    for k in 0..4 {
+                        for l in 0..4 {
+                            let bb = b[k] * b[l];
+                            for a in 0..D {
+                                for c in 0..D {
+                                    acc[k][l][a][c] += bb * m[a][c];
+                                }
+                            }
+                        }
+                    }
+                }
+                if let Some(g) = current {
+                    flush(g, &mut acc);
+                }
+            }
+        }
+    }
+
+    /// `out += Σ_i B_iᵀ M_i B_i v` (points with `skip[i]` left out); `work` holds `B v`.
+    pub fn apply_blocks_add<const D: usize>(
+        &self,
+        blocks: &[[[f64; D]; D]],
+        skip: &[bool],
+        v: &[f64],
+        work: &mut [f64],
+        out: &mut [f64],
+    ) {
+        self.eval::<D>(v, work);
+        for (i, m) in blocks.iter().enumerate() {
+            let mut mv = [0.0; D];
+            if !skip[i] {
+                for a in 0..D {
+                    mv[a] = (0..D).map(|c| m[a][c] * work[i * D + c]).sum::<f64>();
+                }
+            }
+            work[i * D..(i + 1) * D].copy_from_slice(&mv);
+        }
+        self.eval_t_add::<D>(work, out);
+    }
+}

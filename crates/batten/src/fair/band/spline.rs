@@ -1,0 +1,252 @@
+//! The spline form of `band`, for dense points.
+//!
+//! The point form's energy weighs a wave of `L` points `(1/L)⁶` times less than a wave of one
+//! point; from a few thousand points on, the long waves fall below double precision against
+//! the band's terms, the Newton directions along them are rounding, and the solver stalls
+//! (see `docs/algorithms/band.md`, Limits). Dense points carry no more shape than a curve
+//! with a knot every tolerance or so, so the spline form solves the same problem,
+//!
+//! ```text
+//! minimise E(C)  subject to  |C(t_i) − p_i| ≤ D for every point,
+//! ```
+//!
+//! over a cubic B-spline `C` with uniform knots in the points' parameters (clamped for open
+//! curves, periodic for closed ones), and returns `q_i = C(t_i)`. The unknowns are its control
+//! points, `q = B x` with four basis values a point (`design.rs`), the energy is its exact
+//! `∫ |C'''|²` (or the minimum-variation part of it) span by span, and the band's constraints
+//! are all the points': every matrix keeps the band of the point form, with as many rows as
+//! control points, and each interior-point iteration is O(n) to assemble and O(m) to
+//! factorise.
+//!
+//! The interior point needs a start strictly inside the band: a penalised least-squares fit
+//! whose data weights are raised, round by round, at the points it leaves outside 0.9 `D`
+//! ([`feasible_fit`]). When no fit gets there the knots are doubled; when they reach a
+//! quarter of the points the caller falls back on the point form.
+
+use super::design::{Design, SplineMap};
+use super::energy::Energy;
+use crate::error::Result;
+use crate::spline::{MAX_ORDER, basis_derivs};
+
+use super::debias::Penalized;
+
+/// How far from its input point (in tolerances) the start's fit aims to leave every point.
+const START_RADIUS: f64 = 0.9;
+/// How far it may leave one after the last round: strictly inside the band is all the
+/// interior point needs.
+const START_ACCEPT: f64 = 0.999;
+/// The most a point's data weight may grow over the rounds, as a factor (beyond it the fit's
+/// matrix loses its digits).
+const MAX_WEIGHT_GROWTH: f64 = 1e8;
+/// Rounds of re-weighting of the start's fit.
+const FIT_ROUNDS: usize = 40;
+/// The smoothing length of the start's fit, in knot spans: it resolves what the spline can.
+const FIT_SMOOTHING_SPANS: f64 = 0.5;
+
+/// The knots of the spline form and what the solver needs from them.
+#[derive(Debug)]
+pub(super) struct Layout {
+    /// The map from control points to points.
+    pub design: Design,
+    /// For every knot span: its first control point, the coefficients of `C'''/6` on its four
+    /// control points, and its length.
+    pub spans: Vec<(usize, [f64; 4], f64)>,
+    /// The length of a knot span, in the points' parameter units.
+    pub span_length: f64,
+}
+
+impl Layout {
+    /// The energy's scale: `h⁵` for spans of `h` mean spacings, which is the energy with the
+    /// parameter in knot spans (`C'''` scales as `h³`, `dt` as `1/h`). In the point form's
+    /// units the objective of dense points is so small (1e-20 at 10⁶ points) that the
+    /// solver's stopping rule, absolute below 1e-12 a point, would stop at once.
+    pub fn energy_unit(&self) -> f64 {
+        self.span_length.powi(5)
+    }
+}
+
+impl Layout {
+    /// A spline with `spans` uniform knot spans over the parameters `t` (increasing from 0; a
+    /// closed curve's period is `period`, and `t < period`). Open curves: clamped, `spans + 3`
+    /// control points; closed curves: periodic, `spans` control points.
+    pub fn new(t: &[f64], closed: bool, period: f64, spans: usize) -> Layout {
+        if closed {
+            Self::periodic(t, period, spans)
+        } else {
+            Self::clamped(t, spans)
+        }
+    }
+
+    fn clamped(t: &[f64], spans: usize) -> Layout {
+        let end = *t.last().unwrap_or(&0.0);
+        let h = end / spans as f64;
+        let mut u = vec![0.0; 4];
+        u.extend((1..spans).map(|k| k as f64 * h));
+        u.extend([end; 4]);
+        let mut first = Vec::with_capacity(t.len());
+        let mut basis = Vec::with_capacity(t.len());
+        let mut out = [[0.0; MAX_ORDER]; 4];
+        for &ti in t {
+            let s = ((ti / h).floor().max(0.0) as usize).min(spans - 1);
+            basis_derivs(&u, 3, s + 3, ti, 0, &mut out);
+            first.push(s);
+            basis.push([out[0][0], out[0][1], out[0][2], out[0][3]]);
+        }
+        let spans_coef = (0..spans)
+            .map(|s| {
+                let e = |l: usize| -> [f64; 4] { std::array::from_fn(|k| f64::from(k == l)) };
+                let diff = |a: [f64; 4], b: [f64; 4], f: f64| -> [f64; 4] {
+                    std::array::from_fn(|k| (a[k] - b[k]) * f)
+                };
+                let q1: [[f64; 4]; 3] = std::array::from_fn(|j| {
+                    diff(e(j + 1), e(j), 3.0 / (u[s + j + 4] - u[s + j + 1]))
+                });
+                let q2: [[f64; 4]; 2] = std::array::from_fn(|j| {
+                    diff(q1[j + 1], q1[j], 2.0 / (u[s + j + 4] - u[s + j + 2]))
+                });
+                let len = u[s + 4] - u[s + 3];
+                (s, diff(q2[1], q2[0], 1.0 / (6.0 * len)), len)
+            })
+            .collect();
+        Layout {
+            design: Design::Spline(SplineMap {
+                vars: spans + 3,
+                first,
+                basis,
+            }),
+            spans: spans_coef,
+            span_length: h,
+        }
+    }
+
+    fn periodic(t: &[f64], period: f64, spans: usize) -> Layout {
+        let h = period / spans as f64;
+        let mut first = Vec::with_capacity(t.len());
+        let mut basis = Vec::with_capacity(t.len());
+        for &ti in t {
+            let v = ti / h;
+            let s = (v.floor().max(0.0) as usize).min(spans - 1);
+            let u = (v - s as f64).clamp(0.0, 1.0);
+            let w = 1.0 - u;
+            first.push(s);
+            basis.push([
+                w * w * w / 6.0,
+                (3.0 * u * u * u - 6.0 * u * u + 4.0) / 6.0,
+                (-3.0 * u * u * u + 3.0 * u * u + 3.0 * u + 1.0) / 6.0,
+                u * u * u / 6.0,
+            ]);
+        }
+        let c = 1.0 / (6.0 * h * h * h);
+        let spans_coef = (0..spans)
+            .map(|s| (s, [-c, 3.0 * c, -3.0 * c, c], h))
+            .collect();
+        Layout {
+            design: Design::Spline(SplineMap {
+                vars: spans,
+                first,
+                basis,
+            }),
+            spans: spans_coef,
+            span_length: h,
+        }
+    }
+}
+
+/// A start for the interior point: control points (flat, in the solver's units) whose curve is
+/// within [`START_RADIUS`] of every point not pinned, the held ones at `fixed`. The fit
+/// minimises `E(x) + Σ μ_i |(B x)_i − a_i|²` (`centres` = `a`), its weights `μ_i` starting
+/// from a smoothing length of [`FIT_SMOOTHING_SPANS`] knot spans and raised at every point
+/// it leaves outside, by the fourth power of the excess. `None` when [`FIT_ROUNDS`] rounds
+/// do not get there (a fit within [`START_ACCEPT`] is taken after the last round).
+pub(super) fn feasible_fit<const D: usize>(
+    energy: &Energy<D>,
+    layout: &Layout,
+    held: &[bool],
+    pinned: &[bool],
+    fixed: &[f64],
+    centres: &[f64],
+) -> Result<Option<Vec<f64>>> {
+    let design = &layout.design;
+    let anchor = vec![0.0; energy.n * D];
+    let unit = layout.energy_unit();
+    let fit = Penalized::new(energy, unit, design, held, pinned, fixed, &anchor, centres);
+    let mu = unit * (FIT_SMOOTHING_SPANS * layout.span_length).powi(-6);
+    let mut weights = vec![mu; design.points()];
+    for round in 0..FIT_ROUNDS {
+        // A fit whose matrix rounding makes singular is no start.
+        let Ok(x) = fit.minimiser(|i| weights[i], round == 0) else {
+            return Ok(None);
+        };
+        let r = fit.residual(&x);
+        let mut farthest = 0.0_f64;
+        for (i, w) in weights.iter_mut().enumerate() {
+            let len = (0..D)
+                .map(|a| r[i * D + a] * r[i * D + a])
+                .sum::<f64>()
+                .sqrt();
+            farthest = farthest.max(len);
+            if len > START_RADIUS {
+                *w = (*w * (len / START_RADIUS).powi(4).max(2.0)).min(MAX_WEIGHT_GROWTH * mu);
+            }
+        }
+        if farthest <= START_RADIUS || (round + 1 == FIT_ROUNDS && farthest < START_ACCEPT) {
+            return Ok(Some(x));
+        }
+    }
+    Ok(None)
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    /// The basis of every point sums to 1 and reproduces the parameter (linear precision), and
+    /// the spans' third-derivative coefficients kill quadratics and give 1 on `t³/6`'s
+    /// control points, for clamped and periodic layouts.
+    #[test]
+    fn layouts_reproduce_polynomials() {
+        let t: Vec<f64> = (0..200)
+            .map(|i| i as f64 * 0.37 + 0.01 * (i as f64).sin())
+            .collect();
+        let open = Layout::new(&t, false, 0.0, 9);
+        let Design::Spline(map) = &open.design else {
+            panic!()
+        };
+        // Greville abscissae of the clamped knots reproduce t.
+        let end = *t.last().unwrap();
+        let h = end / 9.0;
+        let mut u = vec![0.0; 4];
+        u.extend((1..9).map(|k| k as f64 * h));
+        u.extend([end; 4]);
+        let greville: Vec<f64> = (0..12)
+            .map(|j| (u[j + 1] + u[j + 2] + u[j + 3]) / 3.0)
+            .collect();
+        for (i, ti) in t.iter().enumerate() {
+            let b = map.basis[i];
+            assert!((b.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+            let lin: f64 = (0..4).map(|k| b[k] * greville[map.first[i] + k]).sum();
+            assert!((lin - ti).abs() < 1e-9 * end, "{lin} {ti}");
+        }
+        for (s, coef, _) in &open.spans {
+            let f = |g: &dyn Fn(f64) -> f64| -> f64 {
+                (0..4).map(|k| coef[k] * g(greville[s + k])).sum()
+            };
+            assert!(f(&|_| 1.0).abs() < 1e-12);
+            assert!(f(&|x| x).abs() < 1e-12);
+        }
+        let closed = Layout::new(&t, true, 80.0, 16);
+        let Design::Spline(map) = &closed.design else {
+            panic!()
+        };
+        for b in &map.basis {
+            assert!((b.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+        }
+        assert!(
+            closed
+                .spans
+                .iter()
+                .all(|(_, c, _)| c.iter().sum::<f64>().abs() < 1e-9)
+        );
+    }
+}
