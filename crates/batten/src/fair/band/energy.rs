@@ -74,6 +74,22 @@ pub(super) fn chords_of<const D: usize>(shape: &[[f64; D]], closed: bool) -> Vec
         .collect()
 }
 
+/// The parameters of steps `chords`: their running sums from 0, in units of the mean step,
+/// each step at least [`CHORD_FLOOR_REL`] of the mean (`chords.len() + 1` values; the last is
+/// a closed curve's period).
+pub(super) fn parameters(chords: &[f64]) -> Vec<f64> {
+    let mean = chords.iter().sum::<f64>() / chords.len() as f64;
+    let floor = CHORD_FLOOR_REL * mean;
+    let mut t = Vec::with_capacity(chords.len() + 1);
+    t.push(0.0);
+    let mut acc = 0.0;
+    for c in chords {
+        acc += c.max(floor) / mean;
+        t.push(acc);
+    }
+    t
+}
+
 /// The divided-difference coefficients at parameters `ts`: `c_k = 1 / Π_{m≠k} (t_k − t_m)`.
 fn divided_difference<const K: usize>(ts: [f64; K]) -> [f64; K] {
     let mut coef = [0.0; K];
@@ -194,17 +210,8 @@ impl<const D: usize> Energy<D> {
         metric: Metric,
     ) -> Energy<D> {
         let n = shape.len();
-        let total: f64 = chords.iter().sum();
-        let mean = total / chords.len() as f64;
-        let floor = CHORD_FLOOR_REL * mean;
-        let mut t = Vec::with_capacity(n + 1);
-        t.push(0.0);
-        let mut acc = 0.0;
-        for c in chords {
-            acc += c.max(floor) / mean;
-            t.push(acc);
-        }
-        let period = if closed { acc } else { 0.0 };
+        let t = parameters(chords);
+        let period = if closed { t[chords.len()] } else { 0.0 };
         let param = |i: usize| -> f64 { if i >= n { t[i - n] + period } else { t[i] } };
         let count = if closed { n } else { n - 3 };
         let mut windows: Vec<Window<D>> = (0..count)

@@ -65,19 +65,10 @@ impl<const D: usize> Form<D> {
         hold_ends: bool,
     ) -> Result<Option<Form<D>>> {
         let n = scaled.len() / D;
-        let total: f64 = chords.iter().sum();
-        let mean = total / chords.len() as f64;
-        let floor = energy::CHORD_FLOOR_REL * mean;
-        let mut t = Vec::with_capacity(n + 1);
-        t.push(0.0);
-        let mut acc = 0.0;
-        for c in chords {
-            acc += c.max(floor) / mean;
-            t.push(acc);
-        }
+        let mut t = energy::parameters(chords);
+        let period = t[chords.len()];
         t.truncate(n);
-        let period = acc;
-        let length = total / tolerance;
+        let length = chords.iter().sum::<f64>() / tolerance;
         let min_spans = if closed { 8 } else { 4 };
         let mut spans = ((length / SPAN_TOLERANCES).ceil() as usize).max(min_spans);
         loop {
