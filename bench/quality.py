@@ -470,29 +470,33 @@ def match(result_pos, true_pos, window):
 
 
 def noise_sigma(p, closed=False):
-    """batten's noise estimate σ̂ (`analysis/noise.rs`): 1.4826·median|n·Δ³p|/√20, n the normal
-    of the chord p[i+3+m] − p[i−m] (indices clamped on an open curve, wrapped on a closed one);
-    m = 0 unless the noise is comparable to the spacing: m = ⌈20·rough/spacing⌉ ≤ n/8, rough the
-    same MAD over the whole |Δ³p|, spacing the median distance of neighbours."""
+    """batten's noise estimate σ̂ (`analysis/noise.rs`): 1.4826·median|n·Δᵏp|/√C(2k, k), with
+    k = 5 (k = 3 below 8 points), n the normal of the chord p[i+k+m] − p[i−m] (indices clamped
+    on an open curve, wrapped on a closed one); m = 0 unless the noise is comparable to the
+    spacing: m = ⌈20·rough/spacing⌉ ≤ n/8, rough the same MAD over the whole |Δᵏp|, spacing the
+    median distance of neighbours."""
     n = len(p)
     if n < 4:
         return 0.0
-    count = n if closed else n - 3
+    coef = [-1.0, 5.0, -10.0, 10.0, -5.0, 1.0] if n >= 8 else [-1.0, 3.0, -3.0, 1.0]
+    k = len(coef) - 1
+    gain = math.sqrt(math.comb(2 * k, k))
+    count = n if closed else n - k
     idx = lambda i: np.mod(i, n) if closed else np.clip(i, 0, n - 1)  # noqa: E731
     i = np.arange(count)
-    d3 = p[idx(i + 3)] - 3 * p[idx(i + 2)] + 3 * p[idx(i + 1)] - p[idx(i)]
-    rough = _upper_median(np.hypot(d3[:, 0], d3[:, 1])) * MAD_TO_SIGMA / math.sqrt(20.0)
+    dk = sum(c * p[idx(i + j)] for j, c in enumerate(coef))
+    rough = _upper_median(np.hypot(dk[:, 0], dk[:, 1])) * MAD_TO_SIGMA / gain
     j = np.arange(n if closed else n - 1)
     spacing = _upper_median(np.hypot(*(p[idx(j + 1)] - p[idx(j)]).T))
     reach = 0
     if spacing > 0:
         m = math.ceil(NORMAL_CHORD_NOISE_SPANS * rough / spacing)
         reach = min(int(m), n // 8) if math.isfinite(m) else 0
-    ch = p[idx(i + 3 + reach)] - p[idx(i - reach)]
+    ch = p[idx(i + k + reach)] - p[idx(i - reach)]
     ln = np.hypot(ch[:, 0], ch[:, 1])
     ok = ln > 0
-    v = np.abs(d3[ok, 0] * ch[ok, 1] - d3[ok, 1] * ch[ok, 0]) / ln[ok]
-    return float(MAD_TO_SIGMA * _upper_median(v) / math.sqrt(20.0))
+    v = np.abs(dk[ok, 0] * ch[ok, 1] - dk[ok, 1] * ch[ok, 0]) / ln[ok]
+    return float(MAD_TO_SIGMA * _upper_median(v) / gain)
 
 
 def _upper_median(v):

@@ -17,6 +17,8 @@ Curves (the README in examples/data lists the files):
              integrals by composite Gauss-Legendre quadrature
   cubic      y = x^3 - x, x in [-1.5, 1.5]: 41 points, noise on y
   ellipse    closed, x = 3 cos t, y = 2 sin t: 48 points, first not repeated (JSON)
+  helix      a space curve, x = 2 cos t, y = 2 sin t, z = 0.5 t, t in [0, 4 pi]: 80 points,
+             noise on x, y and z (CSV x,y,z)
 """
 
 import argparse
@@ -86,7 +88,12 @@ def ellipse():
     return np.column_stack([3.0 * np.cos(t), 2.0 * np.sin(t)])
 
 
-# name, truth, sigma, seed, which coordinates get noise ("xy" or "y"), how many interior
+def helix():
+    t = np.linspace(0.0, 4.0 * np.pi, 80)
+    return np.column_stack([2.0 * np.cos(t), 2.0 * np.sin(t), 0.5 * t])
+
+
+# name, truth, sigma, seed, which coordinates get noise ("xy", "xyz" or "y"), how many interior
 # points are perturbed (None: all but the two ends; the closed ellipse: all), closed,
 # the formula for the README.
 CURVES = [
@@ -102,6 +109,8 @@ CURVES = [
      "y = x³ − x, x ∈ [−1.5, 1.5], 41 points equally spaced in x"),
     ("ellipse", ellipse, 0.02, 6, "xy", None, True,
      "closed: x = 3 cos t, y = 2 sin t, t = 2πk/48, k = 0 … 47 (first point not repeated)"),
+    ("helix", helix, 0.03, 7, "xyz", None, False,
+     "space curve: x = 2 cos t, y = 2 sin t, z = t/2, t ∈ [0, 4π], 80 points equally spaced in t"),
 ]
 
 
@@ -116,7 +125,7 @@ def perturb(truth, sigma, seed, coords, count, closed):
     else:
         chosen = np.sort(rng.choice(candidates, size=count, replace=False))
     noisy = truth.copy()
-    cols = [0, 1] if coords == "xy" else [1]
+    cols = {"xy": [0, 1], "xyz": [0, 1, 2]}.get(coords, [1])
     for c in cols:
         noisy[chosen, c] += rng.normal(0.0, sigma, size=len(chosen))
     return noisy, chosen
@@ -126,9 +135,9 @@ def write_csv(path, pts, comment):
     with open(path, "w", encoding="utf-8", newline="\n") as f:
         for line in comment:
             f.write(f"# {line}\n")
-        f.write("x,y\n")
-        for x, y in pts:
-            f.write(f"{float(x)!r},{float(y)!r}\n")
+        f.write("x,y,z\n" if pts.shape[1] == 3 else "x,y\n")
+        for row in pts:
+            f.write(",".join(repr(float(v)) for v in row) + "\n")
 
 
 def write_json(path, pts, closed):
@@ -148,7 +157,7 @@ def main():
     for name, make, sigma, seed, coords, count, closed, formula in CURVES:
         truth = make()
         noisy, chosen = perturb(truth, sigma, seed, coords, count, closed)
-        on = "x and y" if coords == "xy" else "y"
+        on = {"xy": "x and y", "xyz": "x, y and z"}.get(coords, "y")
         which = (f"{len(chosen)} of {len(truth) - 2} interior points" if count is not None
                  else ("all points" if closed else "all interior points"))
         noise = f"N(0, {sigma}²) on {on} of {which}; numpy default_rng seed {seed}"
@@ -177,7 +186,8 @@ def write_readme(path, rows):
         "order), made by `scripts/make_examples.py` (numpy only, fixed seeds; rerun it to",
         "regenerate these files bit for bit). Numbers are written in their shortest exact form.",
         "Open curves are CSV (`# ` comment lines, a header `x,y`, then one point per line); the",
-        "closed ellipse is JSON with `\"closed\": true` and its first point not repeated.",
+        "closed ellipse is JSON with `\"closed\": true` and its first point not repeated; the",
+        "helix is a space curve (header `x,y,z`).",
         "The end points of open curves are never perturbed.",
         "",
         "| files | curve | noise σ | on | points perturbed | seed |",
@@ -194,6 +204,21 @@ def write_readme(path, rows):
         "",
         "Try: `batten compare examples/data/strophoid-noisy.csv --methods han,mst`, or",
         "`batten fair examples/data/sine-noisy.csv -o sine-faired.csv --tolerance 0.1`.",
+        "",
+    ]
+    # The surfaces of scripts/make_surface_examples.py live in the same folder.
+    lines += [
+        '## Surfaces',
+        '',
+        '`hood.json` and `hood-dented.json` (made by `scripts/make_surface_examples.py`, standard',
+        'library only, deterministic) are B-spline surfaces for the `*-surface` commands: a crowned,',
+        'bonnet-like bicubic patch of 12 × 12 control points over 4 × 2 units, z = 0.35 (1 −',
+        '((x − 2)/2.6)²)(1 − 0.5((y − 1)/1.4)²) + 0.04x at the Greville abscissae, and the same net',
+        'with a dent (z −= 0.03 exp(−((i − 4)² + (j − 7)²)/1.5)) and a ripple (z += 0.008 sin(2.2 j)',
+        'on rows i = 7, 8) on interior control points only, so that `--fix-boundary=tangent` holds the',
+        'same boundary. Try `batten fair-surface examples/data/hood-dented.json -o hood-faired.json',
+        '--fix-boundary=tangent` and `batten plot-surface examples/data/hood-dented.json --faired',
+        'hood-faired.json -o hood.png`.',
         "",
     ]
     with open(path, "w", encoding="utf-8", newline="\n") as f:

@@ -5,6 +5,8 @@ use std::process::ExitCode;
 
 use anyhow::anyhow;
 use batten::FairnessMetrics;
+use batten::analysis::SpaceMetrics;
+use serde::Serialize;
 
 use crate::AnalyzeArgs;
 use crate::failure::Failure;
@@ -20,22 +22,86 @@ const DIGITS: usize = 6;
 /// # Errors
 /// Bad input (exit 2); a metric that cannot be computed (exit 1).
 pub fn run(args: &AnalyzeArgs) -> Result<ExitCode, Failure> {
-    let data = input::read_picked(&args.input, args.closed, &args.pick)?;
+    let read = input::read_points_any(&args.input, args.closed, &args.pick)?;
     let name = formats::display_name(&args.input).display().to_string();
-    let spinner = Spinner::start(format!("analysing {} points", data.seq.len()));
-    let metrics = FairnessMetrics::of_seq(&data.seq)
-        .map_err(|e| Failure::from_batten(&format!("{name}: cannot analyse"), e))?;
-    spinner.finish();
-    let text = if args.json {
-        let mut s = serde_json::to_string_pretty(&metrics)
-            .map_err(|e| Failure::failed(anyhow!("cannot encode the metrics: {e}")))?;
-        s.push('\n');
-        s
-    } else {
-        table(&name, &metrics)
+    let failed = |e| Failure::from_batten(&format!("{name}: cannot analyse"), e);
+    let text = match read {
+        input::Points::Planar(data) => {
+            let spinner = Spinner::start(format!("analysing {} points", data.seq.len()));
+            let metrics = FairnessMetrics::of_seq(&data.seq).map_err(failed)?;
+            spinner.finish();
+            if args.json {
+                json(&metrics)?
+            } else {
+                table(&name, &metrics)
+            }
+        }
+        input::Points::Space(data) => {
+            let spinner = Spinner::start(format!("analysing {} points", data.seq.len()));
+            let metrics = SpaceMetrics::of_seq(&data.seq).map_err(failed)?;
+            spinner.finish();
+            if args.json {
+                json(&metrics)?
+            } else {
+                space_table(&name, &metrics)
+            }
+        }
     };
     output::stdout(&text)?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// The metrics as pretty JSON, with a final newline.
+fn json(metrics: &impl Serialize) -> Result<String, Failure> {
+    let mut s = serde_json::to_string_pretty(metrics)
+        .map_err(|e| Failure::failed(anyhow!("cannot encode the metrics: {e}")))?;
+    s.push('\n');
+    Ok(s)
+}
+
+/// The human-readable table of a space curve's metrics.
+fn space_table(name: &str, m: &SpaceMetrics) -> String {
+    let kind = if m.closed { "closed" } else { "open" };
+    let rows: [(&str, String, &str); 9] = [
+        (
+            "curvature extrema",
+            m.curvature_extrema.to_string(),
+            "local extrema of κ(s)",
+        ),
+        (
+            "torsion changes",
+            m.torsion_sign_changes.to_string(),
+            "sign changes of τ(s)",
+        ),
+        (
+            "torsion extrema",
+            m.torsion_extrema.to_string(),
+            "local extrema of τ(s)",
+        ),
+        ("max curvature", sig(m.max_curvature, DIGITS), "max κ"),
+        ("max torsion", sig(m.max_torsion, DIGITS), "max |τ|"),
+        ("strain energy", sig(m.strain_energy, DIGITS), "∫ κ² ds"),
+        (
+            "variation energy",
+            sig(m.variation_energy, DIGITS),
+            "∫ (dκ/ds)² ds",
+        ),
+        ("torsion energy", sig(m.torsion_energy, DIGITS), "∫ τ² ds"),
+        ("length", sig(m.length, DIGITS), "arc length"),
+    ];
+    rows_table(
+        format!("{name}: {} points, {kind} 3-D curve\n", m.points),
+        &rows,
+    )
+}
+
+/// A heading and one aligned line per row.
+fn rows_table(mut s: String, rows: &[(&str, String, &str)]) -> String {
+    for (label, value, what) in rows {
+        // Writing to a String cannot fail.
+        let _ = writeln!(s, "  {label:<18} {value:>14}   {what}");
+    }
+    s
 }
 
 /// The human-readable table.
@@ -76,12 +142,10 @@ fn table(name: &str, m: &FairnessMetrics) -> String {
         ),
         ("length", sig(m.length, DIGITS), "arc length"),
     ];
-    let mut s = format!("{name}: {} points, {kind} curve\n", m.points);
-    for (label, value, what) in &rows {
-        // Writing to a String cannot fail.
-        let _ = writeln!(s, "  {label:<18} {value:>14}   {what}");
-    }
-    s
+    rows_table(
+        format!("{name}: {} points, {kind} curve\n", m.points),
+        &rows,
+    )
 }
 
 #[cfg(test)]

@@ -31,8 +31,8 @@ use std::sync::{Arc, Mutex};
 
 use anyhow::anyhow;
 use batten::FairOptions;
-use batten::fair::{self, EndFix, FairMethod, FairReport};
-use batten::io::{self, Format, IoError, ReadOptions, Source, format_f64};
+use batten::fair::{self, FairMethod, FairReport, SpaceFairReport};
+use batten::io::{self, Format, IoError, ReadOptions, Source, SpaceData, format_f64};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
@@ -70,25 +70,10 @@ pub struct BatchArgs {
     /// (NAME.report.json); created if missing. Never an input's directory
     #[arg(short, long = "output", value_name = "OUT_DIR")]
     out_dir: PathBuf,
-    /// Fairing method (see `batten methods`) [default: the first listed there]
-    #[arg(long, value_name = "NAME")]
-    method: Option<String>,
-    /// Largest distance any point may move, in data units, or `auto`: three times the noise
-    /// estimate σ̂ of the input (`band`'s default)
-    #[arg(long, value_name = "D|auto", allow_hyphen_values = true, value_parser = input::parse_tolerance)]
-    tolerance: Option<input::Tolerance>,
-    /// Keep the ends of an open curve: the end points (bare `--fix-ends`, or `=position`),
-    /// also the end tangents (`=tangent`) or also the end curvatures (`=curvature`)
-    #[arg(long, value_name = "WHAT", num_args = 0..=1, require_equals = true,
-          default_missing_value = "position", value_parser = input::parse_end_fix)]
-    fix_ends: Option<EndFix>,
-    /// Upper bound on the method's iterations (its own unit: sweeps, moves or passes), 1 to
-    /// 1000000
-    #[arg(long, value_name = "N", value_parser = input::parse_max_iterations)]
-    max_iterations: Option<usize>,
-    /// A method parameter, KEY=VALUE (repeat for several; see `batten methods`)
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    set: Vec<String>,
+    #[command(flatten)]
+    how: input::MethodArgs,
+    #[command(flatten)]
+    bounds: input::BoundArgs,
     /// Write one row per input, in input order (file, status, error, points, iterations,
     /// displacements, metrics before and after) to this .json or .csv file
     #[arg(long, value_name = "FILE")]
@@ -207,15 +192,16 @@ impl Row {
 /// errors: they are rows of the summary and decide the exit code.
 pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
     let name = args
+        .how
         .method
         .as_deref()
         .unwrap_or_else(|| fair::default_method());
     let method = input::method(name)?;
-    let params = input::parse_sets(&args.set)?;
+    let params = input::parse_sets(&args.how.set)?;
     let options = input::options(
-        args.tolerance,
-        args.fix_ends.unwrap_or_default(),
-        args.max_iterations,
+        args.bounds.tolerance,
+        args.bounds.fix_ends.unwrap_or_default(),
+        args.how.max_iterations,
         params,
     );
     input::check(method, false, &options)?;
@@ -437,7 +423,21 @@ struct EntityReport<'a> {
     handle: &'a str,
     layer: Option<&'a str>,
     kind: &'a str,
-    report: &'a FairReport,
+    report: AnyReport<'a>,
+}
+
+/// A planar or a space curve's report, serialised as it is.
+#[derive(Serialize)]
+#[serde(untagged)]
+enum AnyReport<'a> {
+    Planar(&'a FairReport),
+    Space(&'a SpaceFairReport),
+}
+
+/// What was faired of one DXF entity.
+enum Done {
+    Planar(batten::Faired),
+    Space(batten::fair::FairedSpace),
 }
 
 /// Fair every curve entity of a DXF file and write the drawing back once, each faired
@@ -501,6 +501,44 @@ fn fair_dxf(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> Vec<Ro
                 }
                 (fair::fair_with(method, &d.seq, options), d.seq.len())
             }
+            Source::Space(d) => {
+                let checked = fair::check_space_method(method.name())
+                    .and_then(|()| fair::check_options(method, d.seq.is_closed(), options))
+                    .and_then(|()| fair::fair_space(method.name(), &d.seq, options));
+                let faired = match checked {
+                    Ok(f) => f,
+                    Err(e) => {
+                        let what = format!("{label}: method {} failed", method.name());
+                        let f = Failure::from_batten(&what, e);
+                        let status = if f.exit_code() == ExitCode::from(EXIT_USAGE) {
+                            Status::InvalidInput
+                        } else {
+                            Status::Failed
+                        };
+                        rows.push(row(
+                            status,
+                            Some(f.error.to_string()),
+                            Some(d.seq.len()),
+                            None,
+                        ));
+                        continue;
+                    }
+                };
+                if let Err(e) = drawing.replace(&handle, io::DxfGeometry::Space(&faired.points)) {
+                    rows.push(row(
+                        Status::Failed,
+                        Some(e.to_string()),
+                        Some(d.seq.len()),
+                        None,
+                    ));
+                    continue;
+                }
+                let mut r = space_row(job, &faired.report, d.seq.len());
+                r.file.clone_from(&label);
+                rows.push(r);
+                faired_all.push((c, Done::Space(faired)));
+                continue;
+            }
             Source::Curve(curve) => {
                 if !method.run_curve_supported() {
                     let message = format!(
@@ -553,7 +591,7 @@ fn fair_dxf(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> Vec<Ro
             )
         };
         rows.push(row(status, error, Some(points), Some(report)));
-        faired_all.push((c, faired));
+        faired_all.push((c, Done::Planar(faired)));
     }
     if faired_all.is_empty() {
         return rows;
@@ -564,7 +602,10 @@ fn fair_dxf(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> Vec<Ro
             handle: c.origin.name.as_deref().unwrap_or_default(),
             layer: c.origin.layer.as_deref(),
             kind: c.kind,
-            report: &f.report,
+            report: match f {
+                Done::Planar(f) => AnyReport::Planar(&f.report),
+                Done::Space(f) => AnyReport::Space(&f.report),
+            },
         })
         .collect();
     // The reports and the drawing as one set, the reports first (as `batten fair` does).
@@ -588,8 +629,9 @@ fn fair_dxf(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> Vec<Ro
 
 fn fair_one_inner(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> Row {
     let file = job.input.display();
-    let data = match input::read(&job.input, false) {
-        Ok(d) => d,
+    let data = match input::read_points_any(&job.input, false, &Default::default()) {
+        Ok(input::Points::Planar(d)) => d,
+        Ok(input::Points::Space(d)) => return fair_space_file(job, method, options, &d),
         Err(f) => {
             let message = f.error.to_string();
             return Row::new(job, Status::InvalidInput, Some(message), None, None);
@@ -603,43 +645,154 @@ fn fair_one_inner(job: &Job, method: &dyn FairMethod, options: &FairOptions) -> 
     }
     let faired = match fair::fair_with(method, &data.seq, options) {
         Ok(f) => f,
-        Err(e) => {
-            let f = Failure::from_batten(&format!("{file}: method {} failed", method.name()), e);
-            let status = if f.exit_code() == ExitCode::from(EXIT_USAGE) {
-                Status::InvalidInput
-            } else {
-                Status::Failed
-            };
-            return Row::new(job, status, Some(f.error.to_string()), points, None);
-        }
+        Err(e) => return method_failed(job, method, e, points),
     };
     let report = &faired.report;
     // Tangents: the method's, else the input's carried through (as `batten fair` does).
     let tangents = faired.tangents.as_deref().or(data.tangents.as_deref());
-    // The report and the points as one set, the report first (as `batten fair` does).
     let written = io::encode_points(&job.output, &faired.points, data.seq.is_closed(), tangents)
+        .map_err(|e| e.to_string());
+    let (status, error) = write_with_report(job, written, report, report.tolerance_met);
+    Row::new(job, status, error, points, Some(report))
+}
+
+/// A row for a method that failed on a file.
+fn method_failed(
+    job: &Job,
+    method: &dyn FairMethod,
+    e: batten::Error,
+    points: Option<usize>,
+) -> Row {
+    let file = job.input.display();
+    let f = Failure::from_batten(&format!("{file}: method {} failed", method.name()), e);
+    let status = if f.exit_code() == ExitCode::from(EXIT_USAGE) {
+        Status::InvalidInput
+    } else {
+        Status::Failed
+    };
+    Row::new(job, status, Some(f.error.to_string()), points, None)
+}
+
+/// Write a file's report and encoded points as one set, the report first (as `batten fair`
+/// does), and say how the file ended.
+fn write_with_report<R: Serialize + Tolerance>(
+    job: &Job,
+    points: Result<Vec<u8>, String>,
+    report: &R,
+    met: bool,
+) -> (Status, Option<String>) {
+    let written = points.and_then(|points| {
+        let report = fair_cmd::report_json(report).map_err(|f| f.error.to_string())?;
+        io::write_atomic_set(&[
+            (&job.report, report.as_bytes()),
+            (&job.output, points.as_slice()),
+        ])
         .map_err(|e| e.to_string())
-        .and_then(|points| {
-            let report = fair_cmd::report_json(report).map_err(|f| f.error.to_string())?;
-            io::write_atomic_set(&[
-                (&job.report, report.as_bytes()),
-                (&job.output, points.as_slice()),
-            ])
-            .map_err(|e| e.to_string())
-        });
-    let (status, error) = match written {
+    });
+    match written {
         Err(message) => (Status::Failed, Some(message)),
-        Ok(()) if report.tolerance_met => (Status::Ok, None),
+        Ok(()) if met => (Status::Ok, None),
         Ok(()) => (
             Status::ToleranceExceeded,
             Some(format!(
-                "{file}: tolerance {} not met: a point moved {}; output and report written anyway",
+                "{}: tolerance {} not met: a point moved {}; output and report written anyway",
+                job.input.display(),
+                report.tolerance().map_or_else(String::new, format_f64),
+                sig(report.max_displacement(), DIGITS),
+            )),
+        ),
+    }
+}
+
+/// What the batch reads of a planar or a space report.
+trait Tolerance {
+    fn tolerance(&self) -> Option<f64>;
+    fn max_displacement(&self) -> f64;
+}
+
+impl Tolerance for FairReport {
+    fn tolerance(&self) -> Option<f64> {
+        self.tolerance
+    }
+    fn max_displacement(&self) -> f64 {
+        self.max_displacement
+    }
+}
+
+impl Tolerance for SpaceFairReport {
+    fn tolerance(&self) -> Option<f64> {
+        self.tolerance
+    }
+    fn max_displacement(&self) -> f64 {
+        self.max_displacement
+    }
+}
+
+/// Fair a space curve's file: `band` and `mst` only (others: an invalid-input row).
+fn fair_space_file(
+    job: &Job,
+    method: &dyn FairMethod,
+    options: &FairOptions,
+    data: &SpaceData,
+) -> Row {
+    let file = job.input.display();
+    let points = Some(data.seq.len());
+    let checked = fair::check_space_method(method.name())
+        .and_then(|()| fair::check_options(method, data.seq.is_closed(), options));
+    if let Err(e) = checked {
+        let f = Failure::from_batten(&file.to_string(), e);
+        return Row::new(
+            job,
+            Status::InvalidInput,
+            Some(f.error.to_string()),
+            points,
+            None,
+        );
+    }
+    let faired = match fair::fair_space(method.name(), &data.seq, options) {
+        Ok(f) => f,
+        Err(e) => return method_failed(job, method, e, points),
+    };
+    let report = &faired.report;
+    let format = Format::from_path(&job.output).unwrap_or(Format::Text);
+    let written = io::format_space_points(
+        format,
+        &job.output,
+        &faired.points,
+        data.seq.is_closed(),
+        &io::Origin::default(),
+    )
+    .map_err(|e| e.to_string());
+    let (status, error) = write_with_report(job, written, report, report.tolerance_met);
+    let mut row = space_row(job, report, data.seq.len());
+    (row.status, row.error) = (status, error);
+    row
+}
+
+/// The summary row of a faired space curve: what its report has of the summary's columns
+/// (no inflections, vibrations, GFI or end changes in space).
+fn space_row(job: &Job, report: &SpaceFairReport, points: usize) -> Row {
+    let (status, error) = if report.tolerance_met {
+        (Status::Ok, None)
+    } else {
+        (
+            Status::ToleranceExceeded,
+            Some(format!(
+                "{}: tolerance {} not met: a point moved {}; output and report written anyway",
+                job.input.display(),
                 report.tolerance.map_or_else(String::new, format_f64),
                 sig(report.max_displacement, DIGITS),
             )),
-        ),
+        )
     };
-    Row::new(job, status, error, points, Some(report))
+    let mut row = Row::new(job, status, error, Some(points), None);
+    row.iterations = Some(report.iterations);
+    row.max_displacement = Some(report.max_displacement);
+    row.sum_displacement = Some(report.sum_displacement);
+    row.tolerance_met = Some(report.tolerance_met);
+    row.strain_energy_before = Some(report.before.strain_energy);
+    row.strain_energy_after = Some(report.after.strain_energy);
+    row
 }
 
 /// The summary's format, from its extension.

@@ -57,8 +57,8 @@ pub(crate) struct Row {
 pub fn run(args: &CompareArgs) -> Result<ExitCode, Failure> {
     let methods = resolve(&args.methods)?;
     let base = input::options(
-        args.tolerance,
-        args.fix_ends.unwrap_or_default(),
+        args.bounds.tolerance,
+        args.bounds.fix_ends.unwrap_or_default(),
         None,
         BTreeMap::new(),
     );
@@ -352,10 +352,7 @@ fn join_note(note: Option<&str>, extra: &str) -> String {
 
 /// The report's status as serialised (`converged`, `tolerance_exceeded`, ...).
 fn status_name(r: &FairReport) -> String {
-    serde_json::to_value(r.status)
-        .ok()
-        .and_then(|v| v.as_str().map(str::to_string))
-        .unwrap_or_else(|| format!("{:?}", r.status))
+    r.status.to_string()
 }
 
 /// The `--format json` document. Structs rather than `json!` so that keys keep this order.

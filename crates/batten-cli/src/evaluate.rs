@@ -97,6 +97,7 @@ pub fn run(args: &EvaluateArgs) -> Result<ExitCode, Failure> {
     let source =
         crate::formats::read_input(&args.input, format, false, &io::Pick::default())?.source;
     let evaluation = match source {
+        io::Source::Space(_) => return Err(crate::input::space_not_planar(&args.input)),
         io::Source::Curve(c) => kuragano::evaluate(&c, &opts),
         io::Source::Points(data) => {
             if data.seq.is_closed() {

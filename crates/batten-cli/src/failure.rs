@@ -47,6 +47,7 @@ impl Failure {
                 | E::UnknownOption { .. }
                 | E::InvalidParameter { .. }
                 | E::ClosedUnsupported { .. }
+                | E::PlanarOnly { .. }
                 | E::TooFewPoints { .. }
                 | E::NonFinite { .. }
                 | E::DuplicatePoint { .. }

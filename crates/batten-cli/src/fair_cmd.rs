@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::anyhow;
-use batten::fair::{self, FairReport};
+use batten::fair::{self, FairReport, FairStatus};
 use batten::io::{self, Format, IoError, PointData, format_f64};
 use batten::spline::BSplineCurve;
 use batten::{Faired, PointSeq, analysis};
@@ -25,15 +25,16 @@ const DIGITS: usize = 4;
 /// Usage errors (exit 2); a method failure or a failed write (exit 1).
 pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
     let name = args
+        .how
         .method
         .as_deref()
         .unwrap_or_else(|| fair::default_method());
     let method = input::method(name)?;
-    let params = input::parse_sets(&args.set)?;
+    let params = input::parse_sets(&args.how.set)?;
     let options = input::options(
-        args.tolerance,
-        args.fix_ends.unwrap_or_default(),
-        args.max_iterations,
+        args.bounds.tolerance,
+        args.bounds.fix_ends.unwrap_or_default(),
+        args.how.max_iterations,
         params,
     );
     input::check(method, args.closed, &options)?;
@@ -81,12 +82,16 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
     };
 
     // A B-spline (JSON, DXF SPLINE, IGES 126, SVG Béziers) is faired as a curve
-    // (control-point methods only).
+    // (control-point methods only); a space curve by the methods that take one.
     let read = formats::read_input(&args.input, in_format, args.closed, &args.pick.pick())?;
     let origin = read.origin;
     let source = match read.source {
         io::Source::Points(d) => Source::Points(d),
         io::Source::Curve(c) => Source::Curve(c),
+        io::Source::Space(d) => {
+            check_distinct(args, to_stdout)?;
+            return crate::fair_space_cmd::run(args, method, &options, &d, &origin, out_format);
+        }
     };
     match &source {
         // A JSON file can make the curve closed: check the method against that too.
@@ -109,20 +114,7 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         }
         Source::Curve(_) => {}
     }
-    if !formats::is_stdio(&args.input) && !to_stdout {
-        io::ensure_distinct(&args.input, &args.output).map_err(Failure::usage)?;
-    }
-    if let Some(report) = &args.report {
-        if !formats::is_stdio(&args.input) {
-            io::ensure_distinct(&args.input, report).map_err(Failure::usage)?;
-        }
-        if same_path(report, &args.output) {
-            return Err(Failure::usage(anyhow!(
-                "--report and --output both name {}",
-                report.display()
-            )));
-        }
-    }
+    check_distinct(args, to_stdout)?;
 
     let input_name = input_name.display();
     let failed =
@@ -172,34 +164,82 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         }
         _ => None,
     };
+    write_outputs(
+        args,
+        report.as_ref().map(|(_, b)| b.as_slice()),
+        curve.as_ref().map(|(p, b)| (p.as_path(), b.as_slice())),
+        &bytes,
+        spinner,
+    )?;
+    let figures = figures(&faired.report);
+    output::note(&summary_line(&figures, data.map(|d| d.lines.as_slice())));
+    Ok(verdict(&figures, args.report.is_some()))
+}
+
+/// Write the report, the curve and the points as one set, all or none, the points last (see
+/// `io::write_atomic_set`); points for standard output go there once the files are written.
+///
+/// # Errors
+/// [`Failure::failed`] for a write that failed.
+pub fn write_outputs(
+    args: &FairArgs,
+    report: Option<&[u8]>,
+    curve: Option<(&Path, &[u8])>,
+    bytes: &[u8],
+    spinner: Spinner,
+) -> Result<(), Failure> {
+    let to_stdout = formats::is_stdio(&args.output);
     let mut set: Vec<(&Path, &[u8])> = Vec::with_capacity(3);
-    set.extend(report.iter().map(|(p, b)| (p.as_path(), b.as_slice())));
-    set.extend(curve.iter().map(|(p, b)| (p.as_path(), b.as_slice())));
+    if let (Some(path), Some(b)) = (&args.report, report) {
+        set.push((path.as_path(), b));
+    }
+    set.extend(curve);
     if !to_stdout {
-        set.push((&args.output, &bytes));
+        set.push((&args.output, bytes));
     }
     io::write_atomic_set(&set).map_err(Failure::failed)?;
     spinner.finish();
     if to_stdout {
-        formats::write_output(&args.output, &bytes)?;
+        formats::write_output(&args.output, bytes)?;
     }
+    Ok(())
+}
 
-    output::note(&summary(&faired.report, data));
-    if faired.report.tolerance_met {
-        Ok(ExitCode::SUCCESS)
-    } else {
-        output::error_line(&format!(
-            "tolerance {} not met: a point moved {}; output{} written anyway",
-            faired.report.tolerance.map_or_else(String::new, format_f64),
-            sig(faired.report.max_displacement, DIGITS),
-            if args.report.is_some() {
-                " and report"
-            } else {
-                ""
-            },
-        ));
-        Ok(ExitCode::from(EXIT_FAILED))
+/// The exit code of a fair whose outputs are written: success, or (with a line on stderr)
+/// exit 1 when the tolerance was not met.
+pub fn verdict(r: &SummaryFigures<'_>, with_report: bool) -> ExitCode {
+    if r.met {
+        return ExitCode::SUCCESS;
     }
+    output::error_line(&format!(
+        "tolerance {} not met: a point moved {}; output{} written anyway",
+        r.tolerance.map_or_else(String::new, format_f64),
+        sig(r.max_displacement, DIGITS),
+        if with_report { " and report" } else { "" },
+    ));
+    ExitCode::from(EXIT_FAILED)
+}
+
+/// Refuse outputs that are the input file, and a report that is the output.
+///
+/// # Errors
+/// [`Failure::usage`].
+pub fn check_distinct(args: &FairArgs, to_stdout: bool) -> Result<(), Failure> {
+    if !formats::is_stdio(&args.input) && !to_stdout {
+        io::ensure_distinct(&args.input, &args.output).map_err(Failure::usage)?;
+    }
+    if let Some(report) = &args.report {
+        if !formats::is_stdio(&args.input) {
+            io::ensure_distinct(&args.input, report).map_err(Failure::usage)?;
+        }
+        if same_path(report, &args.output) {
+            return Err(Failure::usage(anyhow!(
+                "--report and --output both name {}",
+                report.display()
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Whether an output can be written (not a directory, in a directory that exists and takes
@@ -260,34 +300,61 @@ fn curve_bytes(
 }
 
 /// The report as pretty JSON.
-pub fn report_json(report: &FairReport) -> Result<String, Failure> {
+pub fn report_json(report: &impl serde::Serialize) -> Result<String, Failure> {
     let mut json = serde_json::to_string_pretty(report)
         .map_err(|e| Failure::failed(anyhow!("cannot encode the report: {e}")))?;
     json.push('\n');
     Ok(json)
 }
 
-/// The one-line summary: method, status, iterations, largest displacement (and where),
-/// tolerance.
-fn summary(r: &FairReport, data: Option<&PointData>) -> String {
-    let status = serde_json::to_value(r.status)
-        .ok()
-        .and_then(|v| v.as_str().map(str::to_string))
-        .unwrap_or_else(|| format!("{:?}", r.status));
-    let at = match data.and_then(|d| d.lines.get(r.max_displacement_index)) {
+/// What the summary line and the verdict say of a planar report.
+fn figures(r: &FairReport) -> SummaryFigures<'_> {
+    SummaryFigures {
+        method: &r.method,
+        status: r.status,
+        iterations: r.iterations,
+        max_displacement: r.max_displacement,
+        index: r.max_displacement_index,
+        tolerance: r.tolerance,
+        met: r.tolerance_met,
+    }
+}
+
+/// What the summary line says, from a planar or a space report.
+pub struct SummaryFigures<'a> {
+    /// The method.
+    pub method: &'a str,
+    /// How it ended.
+    pub status: FairStatus,
+    /// Its iterations.
+    pub iterations: usize,
+    /// The largest displacement.
+    pub max_displacement: f64,
+    /// The point that moved most.
+    pub index: usize,
+    /// The tolerance, if any.
+    pub tolerance: Option<f64>,
+    /// Whether it was met.
+    pub met: bool,
+}
+
+/// The one-line summary; `lines` gives the input line of each point.
+pub fn summary_line(r: &SummaryFigures<'_>, lines: Option<&[usize]>) -> String {
+    let at = match lines.and_then(|l| l.get(r.index)) {
         Some(line) if r.max_displacement > 0.0 => {
-            format!(" at point {} (line {line})", r.max_displacement_index)
+            format!(" at point {} (line {line})", r.index)
         }
         _ => String::new(),
     };
     let tolerance = match r.tolerance {
         None => "no tolerance".to_string(),
-        Some(t) if r.tolerance_met => format!("tolerance {} met", format_f64(t)),
+        Some(t) if r.met => format!("tolerance {} met", format_f64(t)),
         Some(t) => format!("tolerance {} NOT met", format_f64(t)),
     };
     format!(
-        "{}: {status}, {}, max displacement {}{at}, {tolerance}",
+        "{}: {}, {}, max displacement {}{at}, {tolerance}",
         r.method,
+        r.status,
         output::count(r.iterations, "iteration"),
         sig(r.max_displacement, DIGITS),
     )

@@ -6,7 +6,8 @@ use std::path::Path;
 use anyhow::anyhow;
 use batten::FairOptions;
 use batten::fair::{self, EndFix, FairMethod};
-use batten::io::{self, PointData, Source};
+use batten::io::{self, PointData, Source, SpaceData};
+use clap::Args;
 
 use crate::failure::Failure;
 use crate::formats::{self, PickArgs};
@@ -26,13 +27,45 @@ pub fn read(path: &Path, closed: bool) -> Result<PointData, Failure> {
 /// [`Failure::usage`]: the file's problem, a flag for another format, or a B-spline (which
 /// the command does not take).
 pub fn read_picked(path: &Path, closed: bool, pick: &PickArgs) -> Result<PointData, Failure> {
+    match read_points_any(path, closed, pick)? {
+        Points::Planar(d) => Ok(d),
+        Points::Space(_) => Err(space_not_planar(path)),
+    }
+}
+
+/// What a point file holds: a planar curve or a space curve.
+#[derive(Debug)]
+pub enum Points {
+    /// `x, y` points.
+    Planar(PointData),
+    /// `x, y, z` points.
+    Space(SpaceData),
+}
+
+/// [`read_picked`] for the commands that take space curves too (`analyze`, `fair`, `plot`,
+/// `batch`).
+///
+/// # Errors
+/// As [`read_picked`].
+pub fn read_points_any(path: &Path, closed: bool, pick: &PickArgs) -> Result<Points, Failure> {
     let format = formats::format_of(path, pick.format)?;
     let name = formats::display_name(path);
     pick.check(format, &name.display().to_string())?;
     match formats::read_input(path, format, closed, &pick.pick())?.source {
-        Source::Points(d) => Ok(d),
+        Source::Points(d) => Ok(Points::Planar(d)),
+        Source::Space(d) => Ok(Points::Space(d)),
         Source::Curve(_) => Err(Failure::usage(io::IoError::CurveNotPoints { path: name })),
     }
+}
+
+/// The usage error for a space curve given to a command that takes planar curves.
+pub fn space_not_planar(path: &Path) -> Failure {
+    Failure::usage(anyhow!(
+        "{}; 3-D curves are taken by analyze, plot, and fair and batch with --method band or mst",
+        io::IoError::SpaceNotPlanar {
+            path: formats::display_name(path)
+        }
+    ))
 }
 
 /// Parse `--set KEY=VALUE` arguments. Keys and values are trimmed; the key must be
@@ -192,4 +225,33 @@ mod tests {
             "malformed --set 'a\\nb': expected KEY=VALUE"
         );
     }
+}
+
+/// The bounds every fairing command takes: the tolerance and what to keep at the ends.
+#[derive(Debug, Args)]
+pub struct BoundArgs {
+    /// Largest distance any point may move, in data units, or `auto`: three times the noise
+    /// estimate σ̂ of the input (`band`'s default)
+    #[arg(long, value_name = "D|auto", allow_hyphen_values = true, value_parser = parse_tolerance)]
+    pub tolerance: Option<Tolerance>,
+    /// Keep the ends of an open curve: the end points (bare `--fix-ends`, or `=position`),
+    /// also the end tangents (`=tangent`) or also the end curvatures (`=curvature`)
+    #[arg(long, value_name = "WHAT", num_args = 0..=1, require_equals = true,
+          default_missing_value = "position", value_parser = parse_end_fix)]
+    pub fix_ends: Option<EndFix>,
+}
+
+/// The method and its settings, for `fair` and `batch`.
+#[derive(Debug, Args)]
+pub struct MethodArgs {
+    /// Fairing method (see `batten methods`) [default: the first listed there]
+    #[arg(long, value_name = "NAME")]
+    pub method: Option<String>,
+    /// Upper bound on the method's iterations (its own unit: sweeps, moves or passes), 1 to
+    /// 1000000
+    #[arg(long, value_name = "N", value_parser = parse_max_iterations)]
+    pub max_iterations: Option<usize>,
+    /// A method parameter, KEY=VALUE (repeat for several; see `batten methods`)
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
 }

@@ -16,6 +16,7 @@ mod compare;
 mod evaluate;
 mod failure;
 mod fair_cmd;
+mod fair_space_cmd;
 mod figure;
 mod formats;
 mod input;
@@ -33,7 +34,6 @@ mod usage;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use batten::fair::EndFix;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 /// Fair planar curves: measure the curvature of the curve through a list of points, move the
@@ -103,22 +103,10 @@ struct FairArgs {
     /// .dxf, .igs, .svg); `-` writes standard output. Never the input file
     #[arg(short, long, value_name = "OUTPUT")]
     output: PathBuf,
-    /// Fairing method (see `batten methods`) [default: the first listed there]
-    #[arg(long, value_name = "NAME")]
-    method: Option<String>,
-    /// Largest distance any point may move, in data units, or `auto`: three times the noise
-    /// estimate σ̂ of the input (`band`'s default)
-    #[arg(long, value_name = "D|auto", allow_hyphen_values = true, value_parser = input::parse_tolerance)]
-    tolerance: Option<input::Tolerance>,
-    /// Keep the ends of an open curve: the end points (bare `--fix-ends`, or `=position`),
-    /// also the end tangents (`=tangent`) or also the end curvatures (`=curvature`)
-    #[arg(long, value_name = "WHAT", num_args = 0..=1, require_equals = true,
-          default_missing_value = "position", value_parser = input::parse_end_fix)]
-    fix_ends: Option<EndFix>,
-    /// Upper bound on the method's iterations (its own unit: sweeps, moves or passes), 1 to
-    /// 1000000
-    #[arg(long, value_name = "N", value_parser = input::parse_max_iterations)]
-    max_iterations: Option<usize>,
+    #[command(flatten)]
+    how: input::MethodArgs,
+    #[command(flatten)]
+    bounds: input::BoundArgs,
     /// Write the fairing report (JSON) to this file
     #[arg(long, value_name = "R.json")]
     report: Option<PathBuf>,
@@ -127,9 +115,6 @@ struct FairArgs {
     /// through the faired points for point methods
     #[arg(long, value_name = "FILE")]
     curve_out: Option<PathBuf>,
-    /// A method parameter, KEY=VALUE (repeat for several; see `batten methods`)
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    set: Vec<String>,
     /// The points form a closed curve (a JSON file can say so with "closed": true)
     #[arg(long)]
     closed: bool,
@@ -158,18 +143,11 @@ struct CompareArgs {
     /// displacement of the first method listed, unless it is first itself
     #[arg(long, value_delimiter = ',', value_name = "A,B,...")]
     methods: Vec<String>,
-    /// Largest distance any point may move, in data units, or `auto`: three times the noise
-    /// estimate σ̂ of the input (`band`'s default)
-    #[arg(long, value_name = "D|auto", allow_hyphen_values = true, value_parser = input::parse_tolerance)]
-    tolerance: Option<input::Tolerance>,
+    #[command(flatten)]
+    bounds: input::BoundArgs,
     /// Output format
     #[arg(long, value_enum, default_value_t = TableFormat::Md)]
     format: TableFormat,
-    /// Keep the ends of an open curve: the end points (bare `--fix-ends`, or `=position`),
-    /// also the end tangents (`=tangent`) or also the end curvatures (`=curvature`)
-    #[arg(long, value_name = "WHAT", num_args = 0..=1, require_equals = true,
-          default_missing_value = "position", value_parser = input::parse_end_fix)]
-    fix_ends: Option<EndFix>,
     /// The points form a closed curve
     #[arg(long)]
     closed: bool,

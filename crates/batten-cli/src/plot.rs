@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::anyhow;
 use batten::io;
-use batten::plot::{PlotKind, PlotOptions, render};
+use batten::plot::{PlotKind, PlotOptions, render, render_space};
 use clap::{Args, ValueEnum};
 
 use crate::failure::Failure;
@@ -103,33 +103,99 @@ pub fn run(args: &PlotArgs) -> Result<ExitCode, Failure> {
     inputs.extend(args.faired.as_deref());
     check_output(&args.output, &["svg"], &inputs)?;
 
-    let data = input::read(&args.input, args.closed)?;
+    let data = match input::read_points_any(&args.input, args.closed, &Default::default())? {
+        input::Points::Planar(d) => d,
+        input::Points::Space(d) => return plot_space(args, &options, &d.seq),
+    };
     let faired = match &args.faired {
         None => None,
         Some(path) => {
             let f = input::read(path, data.seq.is_closed())?;
-            if f.seq.len() != data.seq.len() {
-                return Err(Failure::usage(anyhow!(
-                    "{}: {} points, but {} has {}; the faired points must match the input one \
-                     for one",
-                    path.display(),
-                    f.seq.len(),
-                    args.input.display(),
-                    data.seq.len()
-                )));
-            }
-            if f.seq.is_closed() != data.seq.is_closed() {
-                return Err(Failure::usage(anyhow!(
-                    "{}: a closed curve, but {} is open; pass --closed to read both as closed",
-                    path.display(),
-                    args.input.display()
-                )));
-            }
+            check_faired(args, path, f.seq.len(), f.seq.is_closed(), &data.seq)?;
             Some(f.seq)
         }
     };
     let svg =
         render(&data.seq, faired.as_ref(), &options).map_err(|e| render_failure(&args.input, e))?;
+    io::write_atomic(&args.output, svg.as_bytes()).map_err(Failure::failed)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The faired curve must match the input point for point, open or closed alike.
+fn check_faired(
+    args: &PlotArgs,
+    path: &Path,
+    len: usize,
+    closed: bool,
+    input: &batten::PointSeq,
+) -> Result<(), Failure> {
+    check_faired_shape(args, path, (len, closed), (input.len(), input.is_closed()))
+}
+
+/// [`check_faired`] on counts and closedness: `(len, closed)` of the faired file and of the
+/// input.
+fn check_faired_shape(
+    args: &PlotArgs,
+    path: &Path,
+    faired: (usize, bool),
+    input: (usize, bool),
+) -> Result<(), Failure> {
+    if faired.0 != input.0 {
+        return Err(Failure::usage(anyhow!(
+            "{}: {} points, but {} has {}; the faired points must match the input one for one",
+            path.display(),
+            faired.0,
+            args.input.display(),
+            input.0
+        )));
+    }
+    if faired.1 != input.1 {
+        return Err(Failure::usage(anyhow!(
+            "{}: a closed curve, but {} is open; pass --closed to read both as closed",
+            path.display(),
+            args.input.display()
+        )));
+    }
+    Ok(())
+}
+
+/// A space curve: its three orthographic views with combs, κ(s) and τ(s) (`--kind comb`,
+/// `curvature` or `all`; the other kinds are planar).
+fn plot_space(
+    args: &PlotArgs,
+    options: &PlotOptions,
+    input: &batten::SpaceSeq,
+) -> Result<ExitCode, Failure> {
+    if !matches!(args.kind, Kind::Comb | Kind::Curvature | Kind::All) {
+        return Err(Failure::usage(anyhow!(
+            "{}: a 3-D curve is drawn as its plan, profile and body plan with combs, and κ(s) \
+             and τ(s) (--kind all); --kind radius, xc and displacement are for planar curves",
+            args.input.display()
+        )));
+    }
+    let faired = match &args.faired {
+        None => None,
+        Some(path) => match input::read_points_any(path, input.is_closed(), &Default::default())? {
+            input::Points::Space(f) => {
+                check_faired_shape(
+                    args,
+                    path,
+                    (f.seq.len(), f.seq.is_closed()),
+                    (input.len(), input.is_closed()),
+                )?;
+                Some(f.seq)
+            }
+            input::Points::Planar(_) => {
+                return Err(Failure::usage(anyhow!(
+                    "{}: a planar curve, but {} is a 3-D curve",
+                    path.display(),
+                    args.input.display()
+                )));
+            }
+        },
+    };
+    let svg = render_space(input, faired.as_ref(), options)
+        .map_err(|e| render_failure(&args.input, e))?;
     io::write_atomic(&args.output, svg.as_bytes()).map_err(Failure::failed)?;
     Ok(ExitCode::SUCCESS)
 }

@@ -11,7 +11,6 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use batten::fair::EndFix;
 use batten::io::{self, format_f64};
 use batten::plot::{PlotKind, PlotOptions, auto_comb_scale, render};
 use batten::{FairOptions, FairnessMetrics, PointSeq};
@@ -42,15 +41,8 @@ pub struct ReportArgs {
     /// max displacement of the first method listed unless it is first itself
     #[arg(long, value_delimiter = ',', value_name = "A,B,...")]
     methods: Vec<String>,
-    /// Largest distance any point may move, in data units, or `auto`: three times the noise
-    /// estimate σ̂ of the input (`band`'s default)
-    #[arg(long, value_name = "D|auto", allow_hyphen_values = true, value_parser = input::parse_tolerance)]
-    tolerance: Option<input::Tolerance>,
-    /// Keep the ends of an open curve: the end points (bare `--fix-ends`, or `=position`),
-    /// also the end tangents (`=tangent`) or also the end curvatures (`=curvature`)
-    #[arg(long, value_name = "WHAT", num_args = 0..=1, require_equals = true,
-          default_missing_value = "position", value_parser = input::parse_end_fix)]
-    fix_ends: Option<EndFix>,
+    #[command(flatten)]
+    bounds: input::BoundArgs,
     /// The points form a closed curve
     #[arg(long)]
     closed: bool,
@@ -67,14 +59,14 @@ pub fn run(args: &ReportArgs) -> Result<ExitCode, Failure> {
             input: &args.input,
             output: &args.output,
             methods: &args.methods,
-            tolerance: args.tolerance,
-            curve_options: args.fix_ends.is_some() || args.closed,
+            tolerance: args.bounds.tolerance,
+            curve_options: args.bounds.fix_ends.is_some() || args.closed,
         });
     }
     let methods = compare::resolve(&args.methods)?;
     let base = input::options(
-        args.tolerance,
-        args.fix_ends.unwrap_or_default(),
+        args.bounds.tolerance,
+        args.bounds.fix_ends.unwrap_or_default(),
         None,
         BTreeMap::new(),
     );

@@ -3,30 +3,14 @@
 
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
+use common::{assert_usage_error, batten, code, file, names, s, stderr};
 use serde_json::Value;
-
-fn batten(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_batten"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn code(o: &Output) -> i32 {
-    o.status.code().unwrap_or(-1)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// A noisy sine of `n` points as CSV with a header; `phase` makes the curves differ. The
 /// "noise" is a fixed pattern.
@@ -50,22 +34,6 @@ fn noisy_sine_json(n: usize, phase: f64) -> String {
     format!("{{\"points\": [{}]}}\n", rows.join(", "))
 }
 
-fn file(dir: &Path, name: &str, contents: &str) -> PathBuf {
-    let p = dir.join(name);
-    fs::write(&p, contents).unwrap();
-    p
-}
-
-/// The names in `dir`, sorted.
-fn names(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
-}
-
 fn read_json(path: &Path) -> Value {
     serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap()
 }
@@ -73,18 +41,6 @@ fn read_json(path: &Path) -> Value {
 /// The last line of stderr: the counts.
 fn last_line(o: &Output) -> String {
     stderr(o).lines().last().unwrap_or_default().to_string()
-}
-
-/// The run failed with exit 2, one line on stderr containing every needle, nothing on stdout.
-fn assert_usage_error(o: &Output, needles: &[&str]) {
-    let err = stderr(o);
-    assert_eq!(code(o), 2, "stderr: {err}");
-    assert_eq!(err.lines().count(), 1, "not one line: {err:?}");
-    assert!(err.starts_with("error: "), "{err}");
-    for n in needles {
-        assert!(err.contains(n), "{n:?} not in {err:?}");
-    }
-    assert!(o.stdout.is_empty());
 }
 
 /// Split one CSV line into fields (RFC 4180 quoting, no embedded newlines).

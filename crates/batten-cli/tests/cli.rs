@@ -3,34 +3,13 @@
 
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
 use std::fs;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
 
+use common::{assert_usage_error, batten, code, file, s, stderr, stdout};
 use serde_json::Value;
-
-fn batten(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_batten"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn code(o: &Output) -> i32 {
-    o.status.code().unwrap_or(-1)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// A noisy sine, `n` points, as CSV text with a header. The "noise" is a fixed pattern.
 fn noisy_sine(n: usize) -> String {
@@ -41,26 +20,6 @@ fn noisy_sine(n: usize) -> String {
         t.push_str(&format!("{x},{}\n", (x / 2.0).sin() + noise));
     }
     t
-}
-
-/// Write `contents` to `dir/name` and return the path.
-fn file(dir: &Path, name: &str, contents: &str) -> PathBuf {
-    let p = dir.join(name);
-    fs::write(&p, contents).unwrap();
-    p
-}
-
-/// The run failed with exit 2, exactly one line on stderr containing every needle, nothing on
-/// stdout.
-fn assert_usage_error(o: &Output, needles: &[&str]) {
-    let err = stderr(o);
-    assert_eq!(code(o), 2, "stderr: {err}");
-    assert_eq!(err.lines().count(), 1, "not one line: {err:?}");
-    assert!(err.starts_with("error: "), "{err}");
-    for n in needles {
-        assert!(err.contains(n), "{n:?} not in {err:?}");
-    }
-    assert!(o.stdout.is_empty(), "stdout: {}", stdout(o));
 }
 
 /// Bad input files: each must fail with exit 2 and one line naming the file and the line,
@@ -782,9 +741,11 @@ fn bundled_examples_are_valid_inputs() {
         assert_eq!(code(&o), 0, "{}: {}", s(&p), stderr(&o));
         let v: Value = serde_json::from_str(&stdout(&o)).unwrap();
         assert_eq!(v["closed"], name.starts_with("ellipse"), "{name}");
+        // The helix is the space curve.
+        assert_eq!(v["dimension"] == 3, name.starts_with("helix"), "{name}");
         n += 1;
     }
-    assert_eq!(n, 12, "six curves, noisy and truth");
+    assert_eq!(n, 14, "seven curves, noisy and truth");
     assert_eq!(surfaces, 2, "the hood and the dented hood");
 }
 

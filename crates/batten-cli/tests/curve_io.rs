@@ -3,23 +3,14 @@
 
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use batten::Curve;
 use batten::io::{ReadOptions, read_curve_json, read_points};
-
-fn batten(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_batten"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+use common::{batten, s};
 
 fn noisy_sine(dir: &Path) -> PathBuf {
     let mut t = String::from("x,y\n");

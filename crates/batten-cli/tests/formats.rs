@@ -4,6 +4,8 @@
 
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
 use std::fs;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -12,13 +14,7 @@ use std::process::{Command, Output, Stdio};
 use batten::io::{self, Pick, ReadOptions, Source};
 use batten::spline::BSplineCurve;
 use batten::{Curve, Point};
-
-fn batten(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_batten"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+use common::{batten, s};
 
 /// Run with `stdin` piped in.
 fn batten_stdin(args: &[&str], stdin: &[u8]) -> Output {
@@ -31,10 +27,6 @@ fn batten_stdin(args: &[&str], stdin: &[u8]) -> Output {
         .unwrap();
     child.stdin.take().unwrap().write_all(stdin).unwrap();
     child.wait_with_output().unwrap()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 fn sine_csv() -> String {
@@ -60,14 +52,14 @@ fn read(path: &Path, pick: &Pick) -> io::Input {
 fn points(path: &Path) -> Vec<Point> {
     match read(path, &Pick::default()).source {
         Source::Points(d) => d.seq.points().to_vec(),
-        Source::Curve(_) => panic!("{}: a curve", path.display()),
+        other => panic!("{}: not points: {other:?}", path.display()),
     }
 }
 
 fn curve(path: &Path) -> BSplineCurve {
     match read(path, &Pick::default()).source {
         Source::Curve(c) => c,
-        Source::Points(_) => panic!("{}: points", path.display()),
+        other => panic!("{}: not a curve: {other:?}", path.display()),
     }
 }
 
@@ -185,7 +177,7 @@ fn curve_out_in_every_format_is_the_json_curve() {
     }
     let json = match &curves[0].1.as_ref().unwrap().source {
         Source::Curve(c) => c.clone(),
-        Source::Points(_) => panic!("points"),
+        other => panic!("not a curve: {other:?}"),
     };
     for (ext, got) in &curves[1..] {
         let Source::Curve(c) = &got.as_ref().unwrap().source else {

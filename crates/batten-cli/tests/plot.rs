@@ -3,46 +3,10 @@
 
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
+use common::{assert_usage_error, batten, code, example, s, stderr};
 use std::fs;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn batten(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_batten"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn code(o: &Output) -> i32 {
-    o.status.code().unwrap_or(-1)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-/// A bundled example curve.
-fn example(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples/data")
-        .join(name)
-}
-
-/// Exit 2, one line on stderr starting `error: ` and containing every needle.
-fn assert_usage_error(o: &Output, needles: &[&str]) {
-    let err = stderr(o);
-    assert_eq!(code(o), 2, "stderr: {err}");
-    assert_eq!(err.lines().count(), 1, "not one line: {err:?}");
-    assert!(err.starts_with("error: "), "{err}");
-    for n in needles {
-        assert!(err.contains(n), "{n:?} not in {err:?}");
-    }
-}
 
 /// An SVG document as `batten plot` writes it: one `<svg>` element, closed.
 fn assert_svg(text: &str) {

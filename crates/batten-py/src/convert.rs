@@ -1,6 +1,6 @@
 //! numpy arrays in, numpy arrays and plain Python values out.
 
-use batten::Point;
+use batten::{Point, Xyz};
 use numpy::ndarray::Array2;
 use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods as _, PyUntypedArrayMethods as _};
 use pyo3::prelude::*;
@@ -22,31 +22,49 @@ fn float_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, 
     Ok(converted.cast_into::<PyArrayDyn<f64>>()?)
 }
 
-/// Points from an `(n, 2)` array-like of x, y. An `(n, 3)` array is refused: the library
-/// fairs planar curves only.
-pub fn points(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<Point>> {
+/// Points from an array-like: `(n, 2)` (x, y) or `(n, 3)` (x, y, z).
+#[derive(Debug)]
+pub enum Points {
+    /// A planar curve.
+    Planar(Vec<Point>),
+    /// A space curve.
+    Space(Vec<Xyz>),
+}
+
+/// Points from an `(n, 2)` or `(n, 3)` array-like.
+pub fn points_any(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Points> {
     let array = float_array(obj, what)?;
     let shape = array.shape().to_vec();
-    match shape.as_slice() {
-        [_, 2] => {}
-        [_, 3] => {
-            return Err(errors::value(format!(
-                "{what}: 3-D curves (an (n, 3) array) are not supported yet; give an (n, 2) array of x, y"
-            )));
-        }
-        _ => {
-            return Err(errors::value(format!(
-                "{what}: expected an (n, 2) array of x, y, got shape {}",
-                shape_text(&shape)
-            )));
-        }
-    }
     let view = array.try_readonly()?;
     let view = view.as_array();
-    Ok(view
-        .outer_iter()
-        .map(|row| Point::new(row[0], row[1]))
-        .collect())
+    match shape.as_slice() {
+        [_, 2] => Ok(Points::Planar(
+            view.outer_iter()
+                .map(|row| Point::new(row[0], row[1]))
+                .collect(),
+        )),
+        [_, 3] => Ok(Points::Space(
+            view.outer_iter()
+                .map(|row| [row[0], row[1], row[2]])
+                .collect(),
+        )),
+        _ => Err(errors::value(format!(
+            "{what}: expected an (n, 2) array of x, y or an (n, 3) array of x, y, z, got shape {}",
+            shape_text(&shape)
+        ))),
+    }
+}
+
+/// Planar points from an `(n, 2)` array-like (B-spline control points: the library's
+/// B-splines are planar).
+pub fn points(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<Point>> {
+    match points_any(obj, what)? {
+        Points::Planar(p) => Ok(p),
+        Points::Space(p) => Err(errors::value(format!(
+            "{what}: expected an (n, 2) array of x, y, got shape ({}, 3)",
+            p.len()
+        ))),
+    }
 }
 
 /// A 1-D array-like of numbers.
@@ -84,6 +102,16 @@ pub fn points_array<'py>(py: Python<'py>, points: &[Point]) -> Bound<'py, PyArra
     match Array2::from_shape_vec((points.len(), 2), flat) {
         Ok(a) => PyArray2::from_owned_array(py, a),
         Err(_) => PyArray2::zeros(py, [0, 2], false),
+    }
+}
+
+/// An `(n, 3)` array of space points.
+pub fn space_array<'py>(py: Python<'py>, points: &[Xyz]) -> Bound<'py, PyArray2<f64>> {
+    let flat: Vec<f64> = points.iter().flatten().copied().collect();
+    // `flat` holds exactly 3·n values, so the shape always fits.
+    match Array2::from_shape_vec((points.len(), 3), flat) {
+        Ok(a) => PyArray2::from_owned_array(py, a),
+        Err(_) => PyArray2::zeros(py, [0, 3], false),
     }
 }
 

@@ -26,6 +26,7 @@ fn is_usage(e: &batten::Error) -> bool {
             | E::UnknownOption { .. }
             | E::InvalidParameter { .. }
             | E::ClosedUnsupported { .. }
+            | E::PlanarOnly { .. }
             | E::TooFewPoints { .. }
             | E::NonFinite { .. }
             | E::DuplicatePoint { .. }

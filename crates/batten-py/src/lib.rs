@@ -8,6 +8,7 @@
 //!   closed=False, **params)` is `batten fair` (the report is `--report`'s JSON as a dict);
 //! - `fair_many(curves, ...)` fairs a list of curves in parallel (rayon), the GIL released;
 //! - `analyze(points, closed=False)` is `batten analyze --json`;
+//! - points are an `(n, 2)` array, or `(n, 3)` for a space curve (`band`, `mst`, `analyze`);
 //! - `methods()` is `batten methods --json`;
 //! - `BSpline` carries B-spline curves in and out; `FairError` is a failed fair.
 //!
@@ -79,7 +80,7 @@ fn fair_many(
                 .map_err(|e| errors::prefixed(py, &format!("curves[{i}]"), e))?,
         );
     }
-    let outcomes: Vec<Result<batten::Faired, batten::Error>> =
+    let outcomes: Vec<Result<options::Output, batten::Error>> =
         py.detach(|| inputs.par_iter().map(|input| request.run(input)).collect());
     outcomes
         .into_iter()
@@ -134,12 +135,25 @@ fn analyze<'py>(
     points: &Bound<'py, PyAny>,
     closed: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let points = convert::points(points, "points")?;
-    let seq = batten::PointSeq::new(points, closed).map_err(|e| errors::library("points", &e))?;
-    let metrics = py
-        .detach(|| FairnessMetrics::of_seq(&seq))
-        .map_err(|e| errors::library("cannot analyse", &e))?;
-    convert::to_py(py, &metrics)
+    let failed = |e| errors::library("cannot analyse", &e);
+    match convert::points_any(points, "points")? {
+        convert::Points::Planar(points) => {
+            let seq =
+                batten::PointSeq::new(points, closed).map_err(|e| errors::library("points", &e))?;
+            let metrics = py
+                .detach(|| FairnessMetrics::of_seq(&seq))
+                .map_err(failed)?;
+            convert::to_py(py, &metrics)
+        }
+        convert::Points::Space(points) => {
+            let seq =
+                batten::SpaceSeq::new(points, closed).map_err(|e| errors::library("points", &e))?;
+            let metrics = py
+                .detach(|| batten::analysis::SpaceMetrics::of_seq(&seq))
+                .map_err(failed)?;
+            convert::to_py(py, &metrics)
+        }
+    }
 }
 
 /// The fairing methods, the default first: `batten methods --json` as a list of dicts.

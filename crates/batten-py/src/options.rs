@@ -4,9 +4,9 @@
 
 use std::collections::BTreeMap;
 
-use batten::fair::{self, EndFix, FairMethod};
+use batten::fair::{self, EndFix, FairMethod, FairedSpace};
 use batten::spline::BSplineCurve;
-use batten::{FairOptions, Faired, PointSeq};
+use batten::{FairOptions, Faired, PointSeq, SpaceSeq};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyString};
 
@@ -36,6 +36,17 @@ pub enum Input {
     Points(PointSeq),
     /// A B-spline curve, faired as it is.
     Curve(BSplineCurve),
+    /// A validated space curve (`band`, `mst`).
+    Space(SpaceSeq),
+}
+
+/// What a run gives: a planar result (points or B-spline input) or a space curve's.
+#[derive(Debug)]
+pub enum Output {
+    /// From [`Input::Points`] or [`Input::Curve`].
+    Planar(Faired),
+    /// From [`Input::Space`].
+    Space(FairedSpace),
 }
 
 impl Request {
@@ -87,7 +98,8 @@ impl Request {
         Ok(Request { method, options })
     }
 
-    /// Read `obj` as the request's input: a [`BSpline`] or an `(n, 2)` array-like of points.
+    /// Read `obj` as the request's input: a [`BSpline`], an `(n, 2)` array-like of points,
+    /// or an `(n, 3)` one (a space curve, for the methods that fair one).
     pub fn input(&self, obj: &Bound<'_, PyAny>, closed: bool) -> PyResult<Input> {
         if let Ok(b) = obj.cast::<BSpline>() {
             if closed {
@@ -110,20 +122,36 @@ impl Request {
             }
             return Ok(Input::Curve(b.get().curve().clone()));
         }
-        let points = convert::points(obj, "points")?;
-        let seq = PointSeq::new(points, closed).map_err(|e| errors::library("points", &e))?;
-        Ok(Input::Points(seq))
+        match convert::points_any(obj, "points")? {
+            convert::Points::Planar(points) => {
+                let seq =
+                    PointSeq::new(points, closed).map_err(|e| errors::library("points", &e))?;
+                Ok(Input::Points(seq))
+            }
+            convert::Points::Space(points) => {
+                fair::check_space_method(self.method.name())
+                    .map_err(|e| errors::library("", &e))?;
+                let seq =
+                    SpaceSeq::new(points, closed).map_err(|e| errors::library("points", &e))?;
+                Ok(Input::Space(seq))
+            }
+        }
     }
 
     /// Fair `input`. Runs without Python: call it with the GIL released.
     ///
     /// # Errors
     /// The library's error, for [`Request::error`].
-    pub fn run(&self, input: &Input) -> Result<Faired, batten::Error> {
-        match input {
-            Input::Points(seq) => fair::fair_with(self.method, seq, &self.options),
-            Input::Curve(curve) => fair::fair_curve(self.method.name(), curve, &self.options),
-        }
+    pub fn run(&self, input: &Input) -> Result<Output, batten::Error> {
+        Ok(match input {
+            Input::Points(seq) => Output::Planar(fair::fair_with(self.method, seq, &self.options)?),
+            Input::Curve(curve) => {
+                Output::Planar(fair::fair_curve(self.method.name(), curve, &self.options)?)
+            }
+            Input::Space(seq) => {
+                Output::Space(fair::fair_space(self.method.name(), seq, &self.options)?)
+            }
+        })
     }
 
     /// A failed run as the CLI words it: `method mst failed: ...`.

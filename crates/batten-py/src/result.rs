@@ -1,6 +1,7 @@
 //! `batten.FairResult`: the faired points, the report, and the method's curve.
 
-use batten::{FairReport, Faired};
+use batten::FairReport;
+use batten::fair::SpaceFairReport;
 use numpy::PyArray2;
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
@@ -8,8 +9,17 @@ use pyo3::types::PyTuple;
 
 use crate::bspline::BSpline;
 use crate::convert;
+use crate::options::Output;
 
-/// What `batten.fair` returns: `points` (an `(n, 2)` array, same count and order as the
+/// The library's report, planar or for a space curve.
+#[derive(Debug)]
+enum Report {
+    Planar(FairReport),
+    Space(SpaceFairReport),
+}
+
+/// What `batten.fair` returns: `points` (an `(n, 2)` or `(n, 3)` array, as the input: same
+/// count and order as the
 /// input), `report` (a dict with the keys and values of the CLI's `--report` JSON), `curve`
 /// (the method's B-spline, or `None`) and `tangents` (an `(n, 2)` array for methods that
 /// carry tangents, else `None`).
@@ -18,7 +28,7 @@ pub struct FairResult {
     points: Py<PyArray2<f64>>,
     /// The report as the library made it, turned into a dict when first asked for (most of
     /// a fast call's cost would be that dict, and many callers only want the points).
-    source: Option<FairReport>,
+    source: Option<Report>,
     report: PyOnceLock<Py<PyAny>>,
     curve: Option<Py<BSpline>>,
     tangents: Option<Py<PyArray2<f64>>>,
@@ -37,10 +47,22 @@ impl std::fmt::Debug for FairResult {
 
 impl FairResult {
     /// Wrap the library's result.
-    pub fn new(py: Python<'_>, faired: Faired) -> PyResult<FairResult> {
+    pub fn new(py: Python<'_>, output: Output) -> PyResult<FairResult> {
+        let faired = match output {
+            Output::Planar(f) => f,
+            Output::Space(f) => {
+                return Ok(FairResult {
+                    points: convert::space_array(py, &f.points).unbind(),
+                    source: Some(Report::Space(f.report)),
+                    report: PyOnceLock::new(),
+                    curve: None,
+                    tangents: None,
+                });
+            }
+        };
         Ok(FairResult {
             points: convert::points_array(py, &faired.points).unbind(),
-            source: Some(faired.report),
+            source: Some(Report::Planar(faired.report)),
             report: PyOnceLock::new(),
             curve: match faired.curve {
                 Some(c) => Some(Py::new(py, BSpline::from_curve(c))?),
@@ -57,7 +79,8 @@ impl FairResult {
     fn report_object<'py>(&self, py: Python<'py>) -> PyResult<&Bound<'py, PyAny>> {
         let r = self.report.get_or_try_init(py, || -> PyResult<Py<PyAny>> {
             match &self.source {
-                Some(report) => Ok(convert::to_py(py, report)?.unbind()),
+                Some(Report::Planar(report)) => Ok(convert::to_py(py, report)?.unbind()),
+                Some(Report::Space(report)) => Ok(convert::to_py(py, report)?.unbind()),
                 None => Ok(pyo3::types::PyDict::new(py).into_any().unbind()),
             }
         })?;
@@ -67,7 +90,7 @@ impl FairResult {
 
 #[pymethods]
 impl FairResult {
-    /// The faired points, an `(n, 2)` array.
+    /// The faired points, an `(n, 2)` array (`(n, 3)` for a space curve).
     #[getter]
     fn points(&self, py: Python<'_>) -> Py<PyArray2<f64>> {
         self.points.clone_ref(py)

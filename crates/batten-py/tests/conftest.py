@@ -53,10 +53,20 @@ def same_array_bits(a: np.ndarray, b: np.ndarray) -> None:
 
 
 def write_csv(path: Path, points: np.ndarray) -> Path:
-    """Points as CSV with every float in its shortest exact form (`repr`), as the CLI reads."""
-    lines = ["x,y"] + [f"{float(x)!r},{float(y)!r}" for x, y in points]
+    """Points as CSV with every float in its shortest exact form (`repr`), as the CLI reads;
+    `x,y` or, for an (n, 3) array, `x,y,z`."""
+    header = "x,y,z" if points.shape[1] == 3 else "x,y"
+    lines = [header] + [",".join(repr(float(v)) for v in row) for row in points]
     path.write_text("\n".join(lines) + "\n")
     return path
+
+
+def noisy_helix(n: int = 150, seed: int = 0, amplitude: float = 0.01) -> np.ndarray:
+    """Two turns of a helix of radius 1 and pitch 0.5 per turn, Gaussian noise per coordinate."""
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0.0, 4.0 * np.pi, n)
+    truth = np.column_stack([np.cos(t), np.sin(t), 0.5 * t / (2.0 * np.pi)])
+    return truth + amplitude * rng.standard_normal((n, 3))
 
 
 def read_csv(path: Path) -> np.ndarray:

@@ -145,3 +145,27 @@ def test_summary_rows_have_the_batch_summary_values(cli, tmp_path: Path):
         b = {k: v for k, v in b.items() if k not in ("file", "error")}
         r = {k: v for k, v in r.items() if k not in ("curve", "error")}
         same_bits(r, b)
+
+
+def test_space_curves_in_a_dataframe_with_z(client):
+    from conftest import noisy_helix
+
+    helices = [noisy_helix(n=60 + 5 * i, seed=i) for i in range(12)]
+    frame = pd.DataFrame(
+        {
+            "curve": np.repeat(np.arange(12), [len(c) for c in helices]),
+            "x": np.concatenate([c[:, 0] for c in helices]),
+            "y": np.concatenate([c[:, 1] for c in helices]),
+            "z": np.concatenate([c[:, 2] for c in helices]),
+        }
+    )
+    points, summary = bd.fair_dataframe(dd.from_pandas(frame, npartitions=3), z="z", **OPTIONS)
+    pts, rows = dask.compute(points, summary)
+    expected = batten.fair_many(helices, **OPTIONS)
+    by_curve = {c: g for c, g in pts.groupby("curve")}
+    records = {r["curve"]: r for r in rows.to_dict("records")}
+    for i, r in enumerate(expected):
+        same_array_bits(by_curve[i][["x", "y", "z"]].to_numpy(), r.points)
+        assert records[i]["status"] == "ok"
+        assert pd.isna(records[i]["inflections_before"])
+        same_bits(float(records[i]["strain_energy_after"]), r.report["after"]["strain_energy"])

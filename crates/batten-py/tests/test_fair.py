@@ -130,9 +130,9 @@ def test_bad_options_are_value_errors_with_the_cli_message(kwargs, message):
 @pytest.mark.parametrize(
     "points, message",
     [
-        (np.zeros((5, 3)), "points: 3-D curves (an (n, 3) array) are not supported yet; give an (n, 2) array of x, y"),
-        (np.zeros(5), "points: expected an (n, 2) array of x, y, got shape (5,)"),
-        (np.zeros((2, 2, 2)), "points: expected an (n, 2) array of x, y, got shape (2, 2, 2)"),
+        (np.zeros((5, 4)), "points: expected an (n, 2) array of x, y or an (n, 3) array of x, y, z, got shape (5, 4)"),
+        (np.zeros(5), "points: expected an (n, 2) array of x, y or an (n, 3) array of x, y, z, got shape (5,)"),
+        (np.zeros((2, 2, 2)), "points: expected an (n, 2) array of x, y or an (n, 3) array of x, y, z, got shape (2, 2, 2)"),
         ([[0, 0], [1, 1], [1, 1], [2, 2]], "points: point 2 duplicates the point before it (zero-length chord)"),
         ([[0, 0], [1, 1], [2, 2]], "points: too few points: 4 needed, 3 given"),
         ([[0, 0], [1, np.inf], [2, 2], [3, 3]], "points: point 1 is not finite (NaN or infinity)"),
@@ -189,8 +189,8 @@ def test_fair_many_equals_fair_on_each_curve():
 
 
 def test_fair_many_names_the_bad_curve():
-    curves = [noisy_sine(), np.zeros((4, 3)), noisy_sine()]
-    with pytest.raises(ValueError, match=r"^curves\[1\]: points: 3-D curves"):
+    curves = [noisy_sine(), np.zeros((4, 5)), noisy_sine()]
+    with pytest.raises(ValueError, match=r"^curves\[1\]: points: expected an \(n, 2\) array"):
         batten.fair_many(curves)
     near = noisy_sine()
     near[5] = near[4] + 1e-15
@@ -275,7 +275,7 @@ def test_bspline_in_and_out():
 def test_bspline_errors():
     with pytest.raises(ValueError, match="^invalid knot vector: 5 knots for 4 control points of degree 3: expected 8$"):
         batten.BSpline(3, [0, 0, 0, 1, 1], np.zeros((4, 2)) + np.arange(4)[:, None])
-    with pytest.raises(ValueError, match="^control_points: 3-D curves"):
+    with pytest.raises(ValueError, match=r"^control_points: expected an \(n, 2\) array of x, y, got shape \(4, 3\)$"):
         batten.BSpline(3, [0, 0, 0, 0, 1, 1, 1, 1], np.zeros((4, 3)))
     b = bspline_of(noisy_sine(n=30))
     with pytest.raises(ValueError, match=r"^method mst takes points, not a B-spline curve \(B-spline input: salvi, eck-hadenfeld\)$"):

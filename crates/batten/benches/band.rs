@@ -1,41 +1,30 @@
 //! The `band` method inside the method (`Band::run`, the tolerance given as the automatic one
 //! would be, `k·σ̂`), with the default options (3 passes, the debiasing stage), for n = 10³ …
-//! 10⁵ points on a noisy half ellipse (semi-axes 3 and 1, noise 0.1 % of the diagonal per
+//! 10⁶ points on a noisy half ellipse (semi-axes 3 and 1, noise 0.1 % of the diagonal per
 //! coordinate, deterministic).
 //!
-//! The targets of the `band` issue are 10⁵ points in ≤ 0.3 s and 10⁶ in ≤ 3 s; the figures
-//! (BENCHMARKS.md) are far from them, and above about 10⁴ points the solver stalls (the
-//! report says `stalled`): see docs/algorithms/band.md, Limits. The 10⁶ case is left out (a
-//! run takes minutes).
+//! The targets of the `band` issue are 10⁵ points in ≤ 0.3 s and 10⁶ in ≤ 3 s (figures in
+//! BENCHMARKS.md). Above 2000 points `band` solves in the spline form on a working set of
+//! points (docs/algorithms/band.md, Dense points).
 //!
 //! Run: `cargo bench -p batten --bench band -- --warm-up-time 1 --measurement-time 5`
 
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
 use std::hint::black_box;
 
 use batten::fair::{Band, FairMethod, band_tolerance_factor};
 use batten::{FairOptions, Point, PointSeq};
+use common::normal_noise;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 
-const SIZES: [usize; 4] = [1_000, 3_000, 10_000, 100_000];
-
-/// Deterministic pseudo-random noise, approximately standard normal (the sum of four uniforms,
-/// rescaled).
-fn noise_source() -> impl FnMut() -> f64 {
-    let mut state = 0x2545_F491_4F6C_DD1D_u64;
-    let mut uniform = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
-    move || (uniform() + uniform() + uniform() + uniform()) * 3.0_f64.sqrt()
-}
+const SIZES: [usize; 5] = [1_000, 3_000, 10_000, 100_000, 1_000_000];
 
 /// The half ellipse `(3 cos a, sin a)`, `a ∈ [0, π]`, with noise of `rel` times its diagonal.
 fn curve(n: usize, rel: f64) -> Vec<Point> {
-    let mut noise = noise_source();
+    let mut noise = normal_noise();
     let sigma = rel * (36.0_f64 + 1.0).sqrt();
     (0..n)
         .map(|i| {

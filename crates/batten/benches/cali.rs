@@ -11,41 +11,24 @@
 
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
 use std::hint::black_box;
 
 use batten::fair::cali::LocalIndicators;
 use batten::fair::{Cali, FairMethod};
 use batten::spline::{BSplineCurve, LambdaOperator, Parametrization};
 use batten::{FairOptions, Point, PointSeq};
+use common::noisy_spiral;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 
 const SIZES: [usize; 3] = [100, 1_000, 10_000];
-
-/// A spiral arc with deterministic pseudo-random noise of 5 % of the point spacing.
-fn noisy_curve(n: usize) -> Vec<Point> {
-    let mut state = 0x2545_F491_4F6C_DD1D_u64;
-    let mut noise = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
-    let step = 3.0 * std::f64::consts::PI / n as f64;
-    (0..n)
-        .map(|i| {
-            let a = i as f64 * step;
-            let r = 1.0 + 0.3 * a;
-            let e = 0.05 * step * r;
-            Point::new(r * a.cos() + e * noise(), r * a.sin() + e * noise())
-        })
-        .collect()
-}
 
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("cali");
     g.sample_size(10);
     for n in SIZES {
-        let pts = noisy_curve(n);
+        let pts = noisy_spiral(n, 3.0, 0.05);
         let seq = PointSeq::open(pts.clone()).unwrap();
         g.throughput(Throughput::Elements(n as u64));
         // The whole method at the paper's τ = 0.99.

@@ -10,45 +10,22 @@
 
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
 use std::hint::black_box;
 
 use batten::fair::han::Segment;
 use batten::fair::{FairMethod, Han};
-use batten::{FairOptions, Point, PointSeq};
+use batten::{FairOptions, PointSeq};
+use common::{noisy_spiral, uniform_noise};
 use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 
 const SIZES: [usize; 4] = [1_000, 10_000, 100_000, 1_000_000];
 
-/// The deterministic pseudo-random noise of the benchmarks, uniform in [−0.5, 0.5).
-fn noise_source() -> impl FnMut() -> f64 {
-    let mut state = 0x2545_F491_4F6C_DD1D_u64;
-    move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    }
-}
-
-/// The benchmark curve (the same as `benches/mst.rs` and `bench/csaps_speed.py`): a spiral arc
-/// with a deterministic pseudo-random wobble of `wobble` times the point spacing (1 %).
-fn curve(n: usize, wobble: f64) -> Vec<Point> {
-    let mut noise = noise_source();
-    let step = 6.0 * std::f64::consts::PI / n as f64;
-    (0..n)
-        .map(|i| {
-            let a = i as f64 * step;
-            let r = 1.0 + 0.3 * a;
-            let e = wobble * step * r;
-            Point::new(r * a.cos() + e * noise(), r * a.sin() + e * noise())
-        })
-        .collect()
-}
-
 /// One function segment: `x_i = i·h` over three periods of `y = sin(x/2)`, with the same
 /// deterministic wobble of 1% of h on y.
 fn segment(n: usize) -> Segment {
-    let mut noise = noise_source();
+    let mut noise = uniform_noise();
     let h = 12.0 * std::f64::consts::PI / n as f64;
     let x: Vec<f64> = (0..n).map(|i| i as f64 * h).collect();
     let y: Vec<f64> = x
@@ -63,7 +40,7 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("han");
     g.sample_size(10);
     for n in SIZES {
-        let seq = PointSeq::open(curve(n, 0.01)).unwrap();
+        let seq = PointSeq::open(noisy_spiral(n, 6.0, 0.01)).unwrap();
         let opts = FairOptions::default();
         g.throughput(Throughput::Elements(n as u64));
         g.bench_with_input(BenchmarkId::new("method", n), &n, |b, _| {
@@ -73,7 +50,7 @@ fn bench(c: &mut Criterion) {
     // The clean spiral (no wobble): only rounding noise, which han leaves alone, so this is
     // the cost of the set-up and one sweep of scans per segment.
     let n = 1_000_000;
-    let seq = PointSeq::open(curve(n, 0.0)).unwrap();
+    let seq = PointSeq::open(noisy_spiral(n, 6.0, 0.0)).unwrap();
     let opts = FairOptions::default();
     g.throughput(Throughput::Elements(n as u64));
     g.bench_with_input(BenchmarkId::new("clean", n), &n, |b, _| {

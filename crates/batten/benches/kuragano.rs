@@ -7,12 +7,15 @@
 
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
 use std::hint::black_box;
 
 use batten::fair::FairMethod;
 use batten::fair::kuragano::Kuragano;
 use batten::spline::quintic::{self, Ends, QuinticForm};
 use batten::{FairOptions, Point, PointSeq, Vec2};
+use common::noisy_spiral;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 
 const INTERPOLATION_SIZES: [usize; 3] = [1_000, 10_000, 100_000];
@@ -22,32 +25,11 @@ const MODIFICATION_SIZES: [usize; 3] = [100, 300, 1_000];
 /// so the figure is a cost per iteration times this.
 const LM_ITERATIONS: usize = 20;
 
-/// A spiral arc (1.5 turns, radius growing linearly with the angle) with a deterministic
-/// pseudo-random wobble of `wobble` times the point spacing.
-fn curve(n: usize, wobble: f64) -> Vec<Point> {
-    let mut state = 0x2545_F491_4F6C_DD1D_u64;
-    let mut noise = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
-    let step = 3.0 * std::f64::consts::PI / n as f64;
-    (0..n)
-        .map(|i| {
-            let a = i as f64 * step;
-            let r = 1.0 + 0.3 * a;
-            let e = wobble * step * r;
-            Point::new(r * a.cos() + e * noise(), r * a.sin() + e * noise())
-        })
-        .collect()
-}
-
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("kuragano_interpolate");
     g.sample_size(10);
     for n in INTERPOLATION_SIZES {
-        let pts = curve(n, 0.01);
+        let pts = noisy_spiral(n, 3.0, 0.01);
         g.throughput(Throughput::Elements(n as u64));
         g.bench_with_input(BenchmarkId::new("natural", n), &n, |b, _| {
             b.iter(|| quintic::interpolate(black_box(&pts), &Ends::Natural, QuinticForm::BSpline))
@@ -78,7 +60,7 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("kuragano_modify");
     g.sample_size(10);
     for n in MODIFICATION_SIZES {
-        let seq = PointSeq::open(curve(n, 1e-3)).unwrap();
+        let seq = PointSeq::open(noisy_spiral(n, 3.0, 1e-3)).unwrap();
         let opts = FairOptions::default()
             .with_param("degree", 3)
             .with_max_iterations(LM_ITERATIONS);

@@ -5,40 +5,22 @@
 
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
 use std::hint::black_box;
 
 use batten::fair::{FairMethod, Mst, SmoothingSpline};
 use batten::spline::{EndCondition, ParametricCubic, Parametrization, parameters};
 use batten::{FairOptions, Point, PointSeq};
+use common::noisy_spiral;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 
 const SIZES: [usize; 4] = [1_000, 10_000, 100_000, 1_000_000];
 
-/// The benchmark curve (the same as `bench/csaps_speed.py`): a spiral arc with a deterministic
-/// pseudo-random wobble of 1% of the point spacing.
-fn curve(n: usize) -> Vec<Point> {
-    let mut state = 0x2545_F491_4F6C_DD1D_u64;
-    let mut noise = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
-    let step = 6.0 * std::f64::consts::PI / n as f64;
-    (0..n)
-        .map(|i| {
-            let a = i as f64 * step;
-            let r = 1.0 + 0.3 * a;
-            let e = 0.01 * step * r;
-            Point::new(r * a.cos() + e * noise(), r * a.sin() + e * noise())
-        })
-        .collect()
-}
-
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("mst");
     for n in SIZES {
-        let pts = curve(n);
+        let pts = noisy_spiral(n, 6.0, 0.01);
         let t = parameters(&pts, Parametrization::ChordLength, false).unwrap();
         let p = SmoothingSpline::default_p(&t, &vec![1.0; n], false).unwrap();
         g.throughput(Throughput::Elements(n as u64));
@@ -67,7 +49,7 @@ fn bench(c: &mut Criterion) {
 
     let mut g = c.benchmark_group("spline");
     for n in SIZES {
-        let pts = curve(n);
+        let pts = noisy_spiral(n, 6.0, 0.01);
         let t = parameters(&pts, Parametrization::ChordLength, false).unwrap();
         g.throughput(Throughput::Elements(n as u64));
         if n >= 100_000 {

@@ -5,12 +5,15 @@
 //!
 //! Run: `cargo bench -p batten --bench salvi`
 
+mod common;
+
 use std::hint::black_box;
 
 use batten::Point;
 use batten::fair::eck_hadenfeld::{self, EckHadenfeldParams};
 use batten::fair::salvi::{self, SalviParams};
 use batten::spline::{BSplineCurve, KnotVector};
+use common::uniform_noise;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 
 const SIZES: [usize; 3] = [100, 1_000, 10_000];
@@ -21,13 +24,8 @@ const ITERATIONS: usize = 200;
 /// A clamped uniform cubic whose control points follow a sine, with a deterministic
 /// pseudo-random wobble of ±0.03 on the interior points (spacing 0.5).
 fn noisy_curve(n: usize) -> BSplineCurve {
-    let mut state = 0x2545_F491_4F6C_DD1D_u64;
-    let mut noise = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.06
-    };
+    let mut uniform = uniform_noise();
+    let mut noise = move || uniform() * 0.06;
     let pts = (0..n)
         .map(|i| {
             let x = i as f64 * 0.5;

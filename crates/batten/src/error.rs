@@ -89,6 +89,15 @@ pub enum Error {
         /// Comma-separated list of registered methods.
         known: String,
     },
+    /// The method fairs planar curves only, and the input is a space curve.
+    #[error(
+        "method {method} fairs planar curves only; a 3-D curve is faired by band or mst \
+         (--method band)"
+    )]
+    PlanarOnly {
+        /// The method.
+        method: String,
+    },
     /// The method cannot handle closed curves.
     #[error("method {method} does not support closed curves")]
     ClosedUnsupported {

@@ -49,4 +49,4 @@ pub use curve::{Curve, CurveDeriv, Derivatives, Piecewise};
 pub use error::{Error, Result};
 pub use fair::{EndFix, FairOptions, FairReport, Faired};
 pub use geom::PointSeq;
-pub use geom::{BBox, Point, Rigid, Vec2};
+pub use geom::{BBox, Point, Rigid, SpaceSeq, Vec2, Xyz};

@@ -346,6 +346,37 @@ fn dense_points_converge_in_the_spline_form() {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(8))]
+
+    /// The spline form's promises on random dense curves (it solves on a working set of
+    /// points and checks the others): the tolerance holds by the contract's measure, the run
+    /// converges, and held end points stay exactly where they were. The noise is at least
+    /// about the spacing, as in dense scans (with less, the knots every tolerance would
+    /// carry fewer than four points each and the point form runs).
+    #[test]
+    fn dense_points_keep_the_tolerance_in_the_spline_form(
+        n in 2_001usize..4_000,
+        amp in 0.015f64..0.05,
+        seed in any::<u64>(),
+        closed in any::<bool>(),
+        hold in any::<bool>(),
+    ) {
+        let input = noisy(n, amp, seed, closed);
+        let fix = if hold && !closed { EndFix::Position } else { EndFix::Free };
+        let out = fair::fair("band", &input, &FairOptions::default().with_end_fix(fix)).unwrap();
+        let r = &out.report;
+        prop_assert!(r.notes.iter().any(|n| n.contains("spline form")), "{:?}", r.notes);
+        prop_assert_eq!(r.status, FairStatus::Converged);
+        let d = r.tolerance.unwrap();
+        prop_assert!(r.tolerance_met && max_move(input.points(), &out.points) <= d);
+        if fix == EndFix::Position {
+            let (p, q) = (input.points(), &out.points);
+            prop_assert!(p[0] == q[0] && p[n - 1] == q[n - 1]);
+        }
+    }
+}
+
 /// Dense points with held tangents (10 000, noise about 16 spacings) take the point form,
 /// which rounding stops short of its
 /// stopping rule (docs/algorithms/band.md, Limits). The report says so — status `stalled`,
@@ -365,4 +396,21 @@ fn a_run_that_rounding_stops_is_reported_as_stalled_within_the_tolerance() {
     );
     let d = r.tolerance.expect("auto tolerance");
     assert!(r.tolerance_met && max_move(input.points(), &out.points) <= d);
+}
+
+/// A 1000-point noisy clothoid (bench/quality.py's test case, 1 % noise, seed 3) on which the
+/// debiasing stage's local weights met a matrix that rounding left indefinite (the energy's
+/// null space held by tiny weights alone): the run failed with exit 1. The raising of the
+/// weights now stops there, and the run converges inside the tolerance.
+#[test]
+fn an_indefinite_local_weights_matrix_ends_the_raising_not_the_run() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/clothoid-1000-indefinite.csv");
+    let seq = batten::io::read_points(&path, &batten::io::ReadOptions::default())
+        .unwrap()
+        .seq;
+    let out = fair::fair("band", &seq, &FairOptions::default()).unwrap();
+    assert_eq!(out.report.status, FairStatus::Converged);
+    assert!(out.report.tolerance_met);
+    assert!(out.report.max_displacement <= out.report.tolerance.unwrap());
 }

@@ -55,6 +55,48 @@ fn end_fix_names_and_counts() {
     );
 }
 
+/// The report says what was held, not only what was asked: with `--fix-ends` left free,
+/// the methods that keep their end points anyway (`han`, the Kjellander family, the
+/// control-point methods unless `free_ends`) report `position`, and their end points are
+/// indeed exactly the input's; the others report `free`.
+#[test]
+fn the_report_says_what_was_held() {
+    let pts = noisy_sine(40, 0.05, 5);
+    let input = PointSeq::open(pts.clone()).unwrap();
+    let keep = [
+        "han",
+        "kjellander",
+        "poliakoff",
+        "energy",
+        "sapidis-farin",
+        "salvi",
+        "eck-hadenfeld",
+        "cali",
+    ];
+    for method in POINT_METHODS
+        .iter()
+        .chain(&CONTROL_POINT_METHODS)
+        .chain(&["band"])
+    {
+        let out = fair::fair(method, &input, &FairOptions::default()).unwrap();
+        let r = &out.report;
+        let want = if keep.contains(method) {
+            EndFix::Position
+        } else {
+            EndFix::Free
+        };
+        assert_eq!(r.fixed_ends, want, "{method}");
+        assert_eq!(r.fix_ends, want.is_fixed(), "{method}");
+        if want == EndFix::Position {
+            let n = pts.len();
+            assert!(
+                out.points[0] == pts[0] && out.points[n - 1] == pts[n - 1],
+                "{method}: says it held the end points"
+            );
+        }
+    }
+}
+
 #[test]
 fn point_methods_hold_their_end_points() {
     let pts = noisy_sine(40, 0.05, 3);

@@ -1193,6 +1193,23 @@ fn noisy_sine_curve(n: usize, sigma: f64, seed: u64) -> Vec<Point> {
         .collect()
 }
 
+/// `--max-iterations` bounds the report's `iterations` (T per segment and pass): one
+/// iteration asked, at most one reported, whatever the number of passes.
+#[test]
+fn the_reported_iterations_are_bounded_by_max_iterations() {
+    let input = PointSeq::open(noisy_sine_curve(30, 0.03, 3)).unwrap();
+    for t in [1, 2, 5] {
+        let options = FairOptions::default().with_max_iterations(t);
+        let out = fair::fair("han", &input, &options).unwrap();
+        assert!(
+            (1..=t).contains(&out.report.iterations),
+            "{t}: {}",
+            out.report.iterations
+        );
+        assert_eq!(out.report.history.len(), 3);
+    }
+}
+
 #[test]
 fn fairs_a_noisy_sine_curve() {
     // The spec's experiment (§1.7.3): sin(x/2) on [0, 4π], n = 30, noise σ = 0.03; the true
@@ -1209,7 +1226,8 @@ fn fairs_a_noisy_sine_curve() {
         assert_eq!(out.points[0], pts[0]);
         assert_eq!(out.points[29], pts[29]);
         assert!(!out.report.moves.is_empty());
-        assert_eq!(out.report.history.len(), out.report.iterations);
+        assert_eq!(out.report.history.len(), 3);
+        assert!((1..=10).contains(&out.report.iterations));
         assert_eq!(
             out.report.parameters["max_turn"],
             serde_json::json!(FRAC_PI_2)

@@ -58,7 +58,9 @@ def fair(
     closed: bool = False,
     **params: ParamValue,
 ) -> FairResult:
-    """Fair one curve: an (n, 2) array of points, or a BSpline for the methods that take one.
+    """Fair one curve: an (n, 2) array of points, an (n, 3) array (a space curve: methods
+    ``band`` and ``mst``; the tolerance is a 3-D distance), or a BSpline for the methods that
+    take one. ``points`` of the result has the input's shape.
 
     The keywords are ``batten fair``'s flags; further keywords are the method's parameters
     (``--set KEY=VALUE``; ``**{"lambda": 2}`` for a name that is a Python keyword).
@@ -81,7 +83,8 @@ def fair_many(
     """
 
 def analyze(points: ArrayLike, closed: bool = False) -> dict[str, Any]:
-    """The fairness metrics of the curve through the points (``batten analyze --json``)."""
+    """The fairness metrics of the curve through the points (``batten analyze --json``); for an
+    (n, 3) array those of a space curve (``dimension`` 3: curvature, torsion, energies)."""
 
 def methods() -> list[dict[str, Any]]:
     """The methods, the default first (``batten methods --json``): name, summary,

@@ -80,7 +80,10 @@ def _fmax(a: Optional[float], b: Optional[float]) -> Optional[float]:
 
 
 def summary_row(curve: Hashable, report: dict[str, Any]) -> dict[str, Any]:
-    """The summary row of one faired curve, from its report (``batten batch``'s ``Row``)."""
+    """The summary row of one faired curve, from its report (``batten batch``'s ``Row``).
+
+    A space curve's report has no inflections, vibrations, GFI or end changes: those columns
+    are ``None`` for it, as ``batten batch`` leaves them empty."""
     ends = report.get("end_changes")
     before, after = report["before"], report["after"]
     met = report["tolerance_met"]
@@ -99,14 +102,14 @@ def summary_row(curve: Hashable, report: dict[str, Any]) -> dict[str, Any]:
         "max_displacement": report["max_displacement"],
         "sum_displacement": report["sum_displacement"],
         "tolerance_met": met,
-        "inflections_before": before["inflections"],
-        "inflections_after": after["inflections"],
-        "vibrations_before": before["vibrations"],
-        "vibrations_after": after["vibrations"],
+        "inflections_before": before.get("inflections"),
+        "inflections_after": after.get("inflections"),
+        "vibrations_before": before.get("vibrations"),
+        "vibrations_after": after.get("vibrations"),
         "strain_energy_before": before["strain_energy"],
         "strain_energy_after": after["strain_energy"],
-        "gfi_before": before["gfi"],
-        "gfi_after": after["gfi"],
+        "gfi_before": before.get("gfi"),
+        "gfi_after": after.get("gfi"),
         "end_tangent_change": _fmax(*ends["tangent_angle"]) if ends else None,
         "end_curvature_change": (
             _fmax(abs(ends["curvature"][0]), abs(ends["curvature"][1])) if ends else None
@@ -182,12 +185,12 @@ def _pluck(results: list[Any], field: int) -> list[Any]:
 def fair_bag(bag: Any, **options: Any) -> Tuple[Any, Any]:
     """Fair every curve of a Dask bag.
 
-    Elements are ``(n, 2)`` array-likes of points, or ``(curve_id, points)`` pairs (a str or
+    Elements are ``(n, 2)`` (or ``(n, 3)``, space curves) array-likes of points, or ``(curve_id, points)`` pairs (a str or
     int id). ``options`` are those of :func:`batten.fair` (``method``, ``tolerance``,
     ``fix_ends``, ``max_iterations``, ``closed``, the method's parameters).
 
     Returns ``(points, summary)``: two bags in the input's order, the faired ``(n, 2)``
-    arrays (``None`` for a curve that failed) and one summary row (a dict with
+    (``(n, 3)``) arrays (``None`` for a curve that failed) and one summary row (a dict with
     :data:`SUMMARY_COLUMNS`) per curve, ``curve`` the given id or the element's position in
     the bag.
     """
@@ -231,18 +234,18 @@ def _tag(df: Any, number: int) -> Any:
 
 
 def _fair_frame(
-    df: Any, curve_id: str, x: str, y: str, options: dict[str, Any], curve_dtype: Any
+    df: Any, curve_id: str, coords: list[str], options: dict[str, Any], curve_dtype: Any
 ) -> Tuple[Any, Any]:
     df = df.sort_values([curve_id, _PART, _ROW], kind="stable")
     groups = [(c, g) for c, g in df.groupby(curve_id, sort=True)]
-    pairs = [(c, g[[x, y]].to_numpy(dtype=np.float64)) for c, g in groups]
+    pairs = [(c, g[coords].to_numpy(dtype=np.float64)) for c, g in groups]
     results = fair_curves(pairs, **options)
     frames = []
     for (c, g), (_, pts, _) in zip(groups, results):
         if pts is not None:
             g = g.drop(columns=[_PART, _ROW]).copy()
-            g[x] = pts[:, 0]
-            g[y] = pts[:, 1]
+            for k, col in enumerate(coords):
+                g[col] = pts[:, k]
             frames.append(g)
     import pandas as pd
 
@@ -253,23 +256,30 @@ def _fair_frame(
 
 
 def fair_dataframe(
-    ddf: Any, curve_id: str = "curve", x: str = "x", y: str = "y", **options: Any
+    ddf: Any,
+    curve_id: str = "curve",
+    x: str = "x",
+    y: str = "y",
+    z: Optional[str] = None,
+    **options: Any,
 ) -> Tuple[Any, Any]:
     """Fair every curve of a Dask dataframe with one row per point.
 
     Rows with the same ``curve_id`` form one curve, their points in row order (as the
-    dataframe's partitions hold them). ``options`` are those of :func:`batten.fair`.
+    dataframe's partitions hold them). With ``z`` (a column name) the curves are space
+    curves (methods ``band`` and ``mst``). ``options`` are those of :func:`batten.fair`.
 
     Returns ``(points, summary)``: a dataframe with the input's columns and each faired
     curve's rows, ``x`` and ``y`` replaced by the faired coordinates (a curve that failed has
-    no rows), and a dataframe with one row per curve and :data:`SUMMARY_COLUMNS`. Both are
+    no rows; ``z`` too for space curves), and a dataframe with one row per curve and :data:`SUMMARY_COLUMNS`. Both are
     grouped by curve after a shuffle: sort them by ``curve`` when order matters.
     """
     import dask
     import dask.dataframe as dd
 
     check_options(**options)
-    for col in (curve_id, x, y):
+    coords = [x, y] if z is None else [x, y, z]
+    for col in (curve_id, *coords):
         if col not in ddf.columns:
             raise ValueError(f"fair_dataframe: no column {col!r} (columns: {list(ddf.columns)})")
     curve_dtype = ddf.dtypes[curve_id]
@@ -280,7 +290,7 @@ def fair_dataframe(
     )
     shuffled = tagged.shuffle(on=curve_id)
     done = [
-        dask.delayed(_fair_frame, nout=2)(p, curve_id, x, y, options, curve_dtype)
+        dask.delayed(_fair_frame, nout=2)(p, curve_id, coords, options, curve_dtype)
         for p in shuffled.to_delayed()
     ]
     points = dd.from_delayed([d[0] for d in done], meta=meta)

@@ -5,6 +5,8 @@
 //! `GFI = Σ LFI_i`. The paper does not say where κ'' is evaluated; the exact κ'' of a cubic is a
 //! Dirac mass at the knots, so the spec's normative divided difference is used.
 
+use std::sync::OnceLock;
+
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -33,19 +35,34 @@ pub struct FairnessIndicators {
 pub fn fairness_indicators(curve: &BSplineCurve) -> FairnessIndicators {
     let xi = curve.knots().greville(curve.degree());
     let cubic = curve.degree() == 3 && curve.weights().is_none();
-    let kappa: Vec<f64> = xi
-        .par_iter()
-        .map(|&t| {
-            if cubic {
-                // signed_curvature's formula, on the cubic's own derivatives.
-                let [d1, d2, _] = curve.cubic_derivs_in_span(curve.find_span(t), t);
-                let w = d1.length_squared();
-                d1.cross(d2) / (w * w.sqrt())
-            } else {
-                signed_curvature(&curve.derivatives(t))
-            }
-        })
-        .collect();
+    // In fixed chunks, each sweeping its spans forward from one search (the same spans as a
+    // search per point, so the same numbers with any thread count).
+    let kappa_of = |chunk: &[f64]| {
+        let mut span = chunk.first().map_or(0, |&t| curve.find_span(t));
+        chunk
+            .iter()
+            .map(|&t| {
+                if cubic {
+                    // signed_curvature's formula, on the cubic's own derivatives.
+                    span = curve.find_span_from(t, span);
+                    let [d1, d2, _] = curve.cubic_derivs_in_span(span, t);
+                    let w = d1.length_squared();
+                    d1.cross(d2) / (w * w.sqrt())
+                } else {
+                    signed_curvature(&curve.derivatives(t))
+                }
+            })
+            .collect::<Vec<f64>>()
+    };
+    let kappa: Vec<f64> = if xi.len() <= KAPPA_CHUNK {
+        // One chunk: no work for the thread pool (small curves, issue #17).
+        kappa_of(&xi)
+    } else {
+        xi.par_chunks(KAPPA_CHUNK)
+            .map(kappa_of)
+            .collect::<Vec<_>>()
+            .concat()
+    };
     let s = arc_lengths_at_sorted(curve, &xi);
     let lfi = lfi_from_samples(&kappa, &s, None);
     let gfi = lfi.iter().sum();
@@ -64,9 +81,10 @@ pub fn fairness_indicators(curve: &BSplineCurve) -> FairnessIndicators {
 /// for every parameter. The pieces are integrated in parallel, a block at a time, and summed
 /// in order, so the result is the same bit for bit with any number of threads.
 pub(crate) fn arc_lengths_at_sorted(curve: &BSplineCurve, ts: &[f64]) -> Vec<f64> {
-    let gl = GaussLegendre::new(ARC_NODES);
+    static RULE: OnceLock<GaussLegendre> = OnceLock::new();
+    let gl = RULE.get_or_init(|| GaussLegendre::new(ARC_NODES));
     let bp = curve.breakpoints();
-    let piece = |(a, b): (f64, f64)| {
+    let piece = |(a, b, span): (f64, f64, usize)| {
         if curve.weights().is_some() {
             gl.integrate(a, b, |x| curve.first_derivative(x).length_squared().sqrt())
         } else if curve.degree() <= 3 {
@@ -75,7 +93,6 @@ pub(crate) fn arc_lengths_at_sorted(curve: &BSplineCurve, ts: &[f64]) -> Vec<f64
             // (the speed of 10⁶-point GFIs, issue #14).
             let half = 0.5 * (b - a);
             let mid = a + half;
-            let span = curve.find_span(mid);
             let [d1, d2, d3] = if curve.degree() == 3 {
                 curve.cubic_derivs_in_span(span, mid)
             } else {
@@ -87,8 +104,7 @@ pub(crate) fn arc_lengths_at_sorted(curve: &BSplineCurve, ts: &[f64]) -> Vec<f64
                 (d1 + (d2 + d3_half * s) * s).length_squared().sqrt()
             })
         } else {
-            // One span search per piece; the nodes are inside it.
-            let span = curve.find_span(0.5 * (a + b));
+            // The nodes are inside the piece's span.
             gl.integrate(a, b, |x| {
                 curve
                     .first_derivative_in_span(span, x)
@@ -98,9 +114,17 @@ pub(crate) fn arc_lengths_at_sorted(curve: &BSplineCurve, ts: &[f64]) -> Vec<f64
         }
     };
     let mut out = Vec::with_capacity(ts.len());
-    let mut pieces: Vec<(f64, f64)> = Vec::with_capacity(ARC_BLOCK + 8);
+    // Each piece with the span its quadrature evaluates on: the span containing the point
+    // the per-piece search used to look up (its midpoint as each branch of `piece` computes
+    // it), found by walking forward, since the pieces come in order.
+    // (Sized to the curve when it is smaller than a block: a small curve's GFI should not
+    // map and unmap half a megabyte.)
+    let cap = (ts.len() + bp.len()).min(ARC_BLOCK) + 8;
+    let mut pieces: Vec<(f64, f64, usize)> = Vec::with_capacity(cap);
+    let rational = curve.weights().is_some();
+    let mut span = curve.find_span(bp[0]);
     // The number of pieces up to each parameter of the block.
-    let mut ends: Vec<usize> = Vec::with_capacity(ARC_BLOCK + 8);
+    let mut ends: Vec<usize> = Vec::with_capacity(cap);
     let (mut pos, mut s, mut k) = (bp[0], 0.0, 0);
     for (idx, &t) in ts.iter().enumerate() {
         while pos < t {
@@ -115,7 +139,15 @@ pub(crate) fn arc_lengths_at_sorted(curve: &BSplineCurve, ts: &[f64]) -> Vec<f64
             if end <= pos {
                 break;
             }
-            pieces.push((pos, end));
+            let probe = if curve.degree() <= 3 {
+                pos + 0.5 * (end - pos)
+            } else {
+                0.5 * (pos + end)
+            };
+            if !rational {
+                span = curve.find_span_from(probe, span);
+            }
+            pieces.push((pos, end, span));
             pos = end;
         }
         ends.push(pieces.len());
@@ -139,6 +171,9 @@ pub(crate) fn arc_lengths_at_sorted(curve: &BSplineCurve, ts: &[f64]) -> Vec<f64
     }
     out
 }
+
+/// Greville points per parallel work unit of [`fairness_indicators`]'s curvatures.
+const KAPPA_CHUNK: usize = 4096;
 
 /// Pieces per block of [`arc_lengths_at_sorted`].
 const ARC_BLOCK: usize = 16_384;

@@ -9,6 +9,8 @@ mod curvature;
 mod gfi;
 mod metrics;
 mod noise;
+mod space;
+mod space_curve;
 
 pub use arclength::{ArcLengthTable, arc_length};
 pub use curvature::{
@@ -19,4 +21,7 @@ pub use gfi::{FairnessIndicators, fairness_indicators};
 pub use metrics::{
     Displacement, FairnessMetrics, ZERO_REL, analysis_curve, count_sign_changes, displacement, sgn0,
 };
-pub use noise::{MAD_TO_SIGMA, noise_sigma};
+pub(crate) use noise::is_planar;
+pub use noise::{MAD_TO_SIGMA, MEDIAN_LENGTH_2D_TO_SIGMA, noise_sigma, noise_sigma_space};
+pub use space::SpaceMetrics;
+pub use space_curve::{SpaceCubic, SpaceDerivatives, SpaceSample};

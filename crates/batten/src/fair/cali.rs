@@ -445,6 +445,7 @@ fn run_cali(points: &[Point], s: &Settings) -> Result<Outcome> {
         notes,
         curve: Some(state.curve()?),
         tangents: None,
+        ends_held: Some(super::EndFix::Position),
     })
 }
 

@@ -715,6 +715,8 @@ fn outcome(
         notes,
         curve,
         tangents: None,
+        // Held end control points are the clamped curve's end points.
+        ends_held: (!params.free_ends).then_some(super::EndFix::Position),
     }
 }
 
@@ -731,7 +733,7 @@ fn run_closed(input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
             reason: format!("a closed curve is faired as the periodic cubic, not degree {degree}"),
         });
     }
-    if options.params.contains_key("control_points") {
+    if !options.param_is_auto("control_points") {
         return Err(Error::InvalidParameter {
             name: "control_points".into(),
             reason: "a closed curve is interpolated (one control point per point)".into(),

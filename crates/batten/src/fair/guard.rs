@@ -17,10 +17,12 @@
 //!   comparison allows a relative slack of [`CLEAN_SLACK_REL`] on the energy, the size of
 //!   rounding in its computation. `mst` (the csaps baseline) is exempt
 //!   ([`super::FairMethod::keeps_clean`]), and [`super::FairOptions::keep_clean`] turns the
-//!   guard off. The per-move half of the promise, for clean inputs, is in `clean.rs`.
+//!   guard off. The per-move half of the promise, for clean inputs, is in `clean.rs`. Space
+//!   curves ([`super::fair_space`]) have the same guard on their own measures
+//!   ([`SpaceMetrics`]: curvature extrema, torsion sign changes, variation energy).
 
-use super::{FairMethod, FairOptions, Outcome};
-use crate::analysis::FairnessMetrics;
+use super::{FairMethod, FairOptions, HistoryRow, Outcome};
+use crate::analysis::{FairnessMetrics, SpaceMetrics};
 use crate::error::Result;
 use crate::geom::{Point, PointSeq, Rigid, Vec2, pow2, scale_points, unit_scale};
 
@@ -97,9 +99,48 @@ pub(crate) fn in_principal_frame(
 
 /// The factor a method's coordinates are divided by: `1.0` inside the safe range.
 pub(crate) fn method_scale(input: &PointSeq) -> f64 {
-    let s = unit_scale(input.points());
+    method_scale_of(unit_scale(input.points()))
+}
+
+/// The factor a method's coordinates are divided by for data of [`unit_scale`] `s`: `1.0`
+/// inside the safe range, else `s`.
+pub(crate) fn method_scale_of(s: f64) -> f64 {
     let lim = pow2(METHOD_SCALE_RANGE_LOG2);
     if s > 1.0 / lim && s < lim { 1.0 } else { s }
+}
+
+/// The options of a run in coordinates divided by `s`: the method's parameters in data units
+/// converted ([`FairMethod::params_at_scale`]), the tolerance divided.
+pub(crate) fn unit_options(
+    m: &dyn FairMethod,
+    options: &FairOptions,
+    s: f64,
+) -> Result<FairOptions> {
+    let mut opts = m.params_at_scale(options, s)?;
+    opts.tolerance = options.tolerance.map(|t| t / s);
+    Ok(opts)
+}
+
+/// The parts of an outcome computed in coordinates divided by `s` that every method has, back
+/// in data units: the history's distances and the reported parameters in data units
+/// ([`FairMethod::report_params_at_scale`]), and a note.
+pub(crate) fn trace_from_unit(
+    m: &dyn FairMethod,
+    history: &mut [HistoryRow],
+    parameters: &mut serde_json::Map<String, serde_json::Value>,
+    notes: &mut Vec<String>,
+    s: f64,
+) {
+    for h in history {
+        h.max_distance *= s;
+    }
+    m.report_params_at_scale(parameters, s);
+    notes.push(format!(
+        "the method ran on the coordinates divided by 2^{} (the data's scale is outside \
+         2^±{METHOD_SCALE_RANGE_LOG2}); displacements, metrics and the curve are in data \
+         units, the method's own measures in those units",
+        s.log2()
+    ));
 }
 
 /// The input and the options in unit coordinates (`s` from [`method_scale`]).
@@ -110,9 +151,7 @@ pub(crate) fn to_unit(
     s: f64,
 ) -> Result<(PointSeq, FairOptions)> {
     let unit = input.with_points(scale_points(input.points(), 1.0 / s))?;
-    let mut opts = m.params_at_scale(options, s)?;
-    opts.tolerance = options.tolerance.map(|t| t / s);
-    Ok((unit, opts))
+    Ok((unit, unit_options(m, options, s)?))
 }
 
 /// An outcome computed in unit coordinates, back in data units: points, the curve, move
@@ -127,16 +166,13 @@ pub(crate) fn from_unit(m: &dyn FairMethod, outcome: &mut Outcome, s: f64) -> Re
     for mv in &mut outcome.moves {
         mv.distance *= s;
     }
-    for h in &mut outcome.history {
-        h.max_distance *= s;
-    }
-    m.report_params_at_scale(&mut outcome.parameters, s);
-    outcome.notes.push(format!(
-        "the method ran on the coordinates divided by 2^{} (the data's scale is outside \
-         2^±{METHOD_SCALE_RANGE_LOG2}); displacements, metrics and the curve are in data \
-         units, the method's own measures in those units",
-        s.log2()
-    ));
+    trace_from_unit(
+        m,
+        &mut outcome.history,
+        &mut outcome.parameters,
+        &mut outcome.notes,
+        s,
+    );
     Ok(())
 }
 
@@ -161,16 +197,55 @@ pub(crate) fn worse(before: &FairnessMetrics, after: &FairnessMetrics) -> Option
             before.vibrations, after.vibrations
         ));
     }
-    if after.variation_energy > before.variation_energy * (1.0 + CLEAN_SLACK_REL)
-        || (after.variation_energy.is_nan() && !before.variation_energy.is_nan())
-    {
+    why.extend(higher_energy(
+        before.variation_energy,
+        after.variation_energy,
+    ));
+    (!why.is_empty()).then(|| why.join(" and "))
+}
+
+/// The clean-curve rule's energy part: why the variation energy `after` is higher than
+/// `before` beyond [`CLEAN_SLACK_REL`] (or NaN where it was not), or `None`.
+fn higher_energy(before: f64, after: f64) -> Option<String> {
+    (after > before * (1.0 + CLEAN_SLACK_REL) || (after.is_nan() && !before.is_nan())).then(|| {
+        format!(
+            "a higher variation energy ∫(dκ/ds)² ds ({before:.6e} → {after:.6e} in units of \
+             the data's scale)"
+        )
+    })
+}
+
+/// The clean-curve rule for space curves: why `after` is worse than `before` (more
+/// curvature extrema, more torsion sign changes, or a higher variation energy beyond
+/// [`CLEAN_SLACK_REL`]), or `None`. Both in the same (unit) coordinates.
+pub(crate) fn worse_space(before: &SpaceMetrics, after: &SpaceMetrics) -> Option<String> {
+    let mut why = Vec::new();
+    if after.curvature_extrema > before.curvature_extrema {
         why.push(format!(
-            "a higher variation energy ∫(dκ/ds)² ds ({:.6e} → {:.6e} in units of the data's \
-             scale)",
-            before.variation_energy, after.variation_energy
+            "more curvature extrema ({} → {})",
+            before.curvature_extrema, after.curvature_extrema
         ));
     }
+    if after.torsion_sign_changes > before.torsion_sign_changes {
+        why.push(format!(
+            "more torsion sign changes ({} → {})",
+            before.torsion_sign_changes, after.torsion_sign_changes
+        ));
+    }
+    why.extend(higher_energy(
+        before.variation_energy,
+        after.variation_energy,
+    ));
     (!why.is_empty()).then(|| why.join(" and "))
+}
+
+/// The note of a result the clean-curve guard replaced by the input; `why` from [`worse`] or
+/// [`worse_space`].
+pub(crate) fn guard_note(why: &str) -> String {
+    format!(
+        "the result had {why} than the input, so the input is returned unchanged (the \
+         clean-curve guard; keep_clean = false turns it off)"
+    )
 }
 
 /// Rewrite the parameter `key` of `options`, a quantity of length power `power` given in

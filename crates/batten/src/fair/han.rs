@@ -72,13 +72,17 @@
 //!
 //! # Common options
 //!
-//! - **Ends.** The paper fixes `P_1` and `P_N` and so does `han`, whatever `fix_ends` says.
+//! - **Ends.** The paper fixes `P_1` and `P_N` and so does `han`, whatever `fix_ends` says
+//!   (its report says `fixed_ends: position` at least).
 //!   `--fix-ends=tangent` (`curvature`) also holds the second (and third) point at each end
 //!   of an open curve: they get zero-width bounds, so a move that would shift one is not made.
 //! - **Tolerance.** A hard bound: every move is scaled back (as a whole, keeping its shape) so
 //!   that no point leaves the disc of radius D around its *input* position; blending is a convex
 //!   combination, which keeps points inside the disc.
-//! - **`max_iterations`** is T, the iterations per segment and pass (default 10).
+//! - **`max_iterations`** is T, the iterations per segment and pass (default 10). The
+//!   report's `iterations` is in the same unit: the most iterations any segment ran in a
+//!   pass (an iteration that moved nothing ends a segment's pass), so it never exceeds
+//!   `--max-iterations`; the passes are the report's `history`, one row each.
 //! - **Closed curves** are supported seam-aware: pass p cuts the cycle at point
 //!   `⌊p·N/passes⌋`, fairs the open sequence from that point round to itself (the cut point
 //!   repeated at the end, both copies fixed), and writes the result back. Successive passes cut
@@ -101,7 +105,9 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
-use super::{FairMethod, FairStatus, HistoryRow, Move, Outcome, ParamSpec, clamp_to_tolerance};
+use super::{
+    EndFix, FairMethod, FairStatus, HistoryRow, Move, Outcome, ParamSpec, clamp_to_tolerance,
+};
 use crate::analysis::{ZERO_REL, count_sign_changes, sgn0};
 use crate::error::{Error, Result};
 use crate::fair::FairOptions;
@@ -162,7 +168,8 @@ pub const ROUNDING_FLOOR_FACTOR: f64 = 64.0;
 /// condition numbers below 30 on sane grids (spec §1.7).
 pub const SINGULAR_REL: f64 = 1e-12;
 /// A segment with a chord steeper than this in its bisector frame (`|ΔY/ΔX|`, ≈ 89.4°) is
-/// left unfaired (\[CHOICE\] guard). The function-spline proxy assumes moderate slopes (spec §1.8
+/// re-partitioned with half the turning threshold, down to π/8, and left unfaired only past
+/// that (\[CHOICE\] guard). The function-spline proxy assumes moderate slopes (spec §1.8
 /// note: up to 76 seen on the strophoid with `max_turn = π`, faired with some drift). Steeper
 /// segments come from the minimum-length rule extending a segment round a tight loop until it
 /// turns by almost π; their spacing ratios reach 1e-6, the unit responses are huge and the
@@ -1431,7 +1438,7 @@ impl Segment {
         }
     }
 
-    /// Move points `start..start+gammas.len()` (interior, at most 4) by `gammas`, scaled back
+    /// Move points `start..start+gammas.len()` (interior, at most 5: fine case 3) by `gammas`, scaled back
     /// to the bounds, and update c (eq 13), e and their maxima on the changed range. Returns
     /// the scale and the applied displacements, or `None` when nothing moved.
     fn move_points(&mut self, start: usize, gammas: &[f64]) -> Option<(f64, [f64; 5])> {
@@ -1757,8 +1764,7 @@ impl HanParams {
             .with_lambda_coarse(o.param_f64_in("lambda_coarse", DEFAULT_LAMBDA_COARSE, 0.0, 1.0)?)
             .with_lambda_fine(o.param_f64_in("lambda_fine", DEFAULT_LAMBDA_FINE, 0.0, 1.0)?)
             .with_alpha_factor(o.param_f64_in("alpha_factor", DEFAULT_ALPHA_FACTOR, 0.0, 1.0)?);
-        let segment =
-            segment.with_fine_run3(super::local::param_bool(o, "fine_run3", DEFAULT_FINE_RUN3)?);
+        let segment = segment.with_fine_run3(o.param_bool("fine_run3", DEFAULT_FINE_RUN3)?);
         segment.validate()?;
         Ok(HanParams {
             segment,
@@ -1802,6 +1808,9 @@ struct RunLog {
     refined: usize,
     /// Moves refused by the clean-curve check.
     refused: usize,
+    /// The most iterations one segment ran in one pass with a move (at most T,
+    /// `--max-iterations`): the report's `iterations`, in the unit the option bounds.
+    iterations: usize,
 }
 
 impl RunLog {
@@ -1831,6 +1840,7 @@ impl RunLog {
         self.skipped.extend(later.skipped);
         self.refined += later.refined;
         self.refused += later.refused;
+        self.iterations = self.iterations.max(later.iterations);
     }
 }
 
@@ -1988,10 +1998,11 @@ fn fair_span(
         seg = seg.with_bounds(lo, hi)?;
     }
     let mut moves = 0;
-    seg.fair(ctx.params.iterations, |m| {
+    let active = seg.fair(ctx.params.iterations, |m| {
         moves += 1;
         log.record(ctx.pass, index_of(m.i), m);
     });
+    log.iterations = log.iterations.max(active);
     log.refused += seg.refused_moves();
     let faired = pts
         .iter()
@@ -2188,11 +2199,12 @@ impl FairMethod for Han {
         Ok(Outcome {
             points: cur,
             status,
-            iterations: passes_done,
+            iterations: log.iterations,
             moves: log.moves,
             history,
             parameters,
             notes,
+            ends_held: Some(EndFix::Position),
             ..Outcome::default()
         })
     }

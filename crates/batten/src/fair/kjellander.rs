@@ -549,7 +549,7 @@ impl Threshold {
     /// default, is the same as leaving it out).
     pub(super) fn from_options(options: &FairOptions) -> Result<Threshold> {
         let rel = options.param_f64_in("threshold", DEFAULT_THRESHOLD, 0.0, 1.0)?;
-        if options.params.get("epsilon").map(|s| s.trim()) == Some("auto") {
+        if options.param_is_auto("epsilon") {
             return Ok(Threshold::Relative(rel));
         }
         match options.param_f64("epsilon")? {
@@ -1068,8 +1068,7 @@ pub(super) fn driven_parameters(
 /// `reparametrize` (always false on the uniform one). They need no input.
 fn point_params(uniform: bool, options: &FairOptions) -> Result<(Threshold, bool)> {
     let threshold = Threshold::from_options(options)?;
-    let reparametrize =
-        !uniform && options.param_choice("reparametrize", "true", &["true", "false"])? == "true";
+    let reparametrize = !uniform && options.param_bool("reparametrize", true)?;
     Ok((threshold, reparametrize))
 }
 
@@ -1138,6 +1137,7 @@ fn run_points(
         notes: driven.notes,
         curve: None,
         tangents: None,
+        ends_held: Some(super::EndFix::Position),
     })
 }
 
@@ -1297,6 +1297,7 @@ pub fn fair_hermite(
         notes: driven.notes,
         curve: None,
         tangents: Some(state.m),
+        ends_held: Some(super::EndFix::Position),
     })
 }
 

@@ -1611,26 +1611,12 @@ impl Kuragano {
     fn options(options: &FairOptions) -> Result<(KuraganoOptions, Option<usize>)> {
         let mut k = KuraganoOptions::DEFAULT
             .with_max_iterations(options.iterations_or(DEFAULT_MAX_ITERATIONS));
-        let degree = match options.params.get("degree").map(|s| s.trim()) {
-            None | Some("auto") => None,
-            Some(_) => Some(options.param_usize_in("degree", 1, MIN_DEGREE, MAX_DEGREE)?),
-        };
-        if !matches!(
-            options.params.get("samples").map(|s| s.trim()),
-            None | Some("auto")
-        ) {
-            k.samples = Some(options.param_usize_in(
-                "samples",
-                DEFAULT_SAMPLES,
-                MIN_SAMPLES,
-                MAX_SAMPLES,
-            )?);
+        let degree = options.param_auto_usize_in("degree", MIN_DEGREE, MAX_DEGREE)?;
+        if let Some(samples) = options.param_auto_usize_in("samples", MIN_SAMPLES, MAX_SAMPLES)? {
+            k.samples = Some(samples);
         }
-        if !matches!(
-            options.params.get("rho_max").map(|s| s.trim()),
-            None | Some("auto")
-        ) {
-            k.rho_max = Some(options.param_f64_in("rho_max", 1.0, f64::MIN_POSITIVE, f64::MAX)?);
+        if let Some(rho) = options.param_auto_f64_in("rho_max", f64::MIN_POSITIVE, f64::MAX)? {
+            k.rho_max = Some(rho);
         }
         k.residual = match options.param_choice("residual", "rho", &["rho", "kappa"])? {
             "kappa" => Residual::Kappa,

@@ -438,40 +438,13 @@ pub(crate) const FIT_PARAMS: [ParamSpec; 3] = [
 /// [`Error::InvalidParameter`].
 pub(crate) fn check_fit_params(options: &FairOptions) -> Result<()> {
     let degree = fit_degree(options)?;
-    if !matches!(
-        options.params.get("control_points").map(|s| s.trim()),
-        None | Some("auto")
-    ) {
-        options.param_usize_in("control_points", degree + 1, degree + 1, usize::MAX)?;
-    }
-    param_bool(options, "free_ends", false).map(|_| ())
+    options.param_auto_usize_in("control_points", degree + 1, usize::MAX)?;
+    options.param_bool("free_ends", false).map(|_| ())
 }
 
 /// The `degree` of the B-spline fitted to point input, 2..=5.
 pub(crate) fn fit_degree(options: &FairOptions) -> Result<usize> {
     options.param_usize_in("degree", DEFAULT_FIT_DEGREE, 2, 5)
-}
-
-/// A boolean method parameter: `true/false`, `yes/no`, `1/0`, `on/off`.
-///
-/// # Errors
-/// [`Error::InvalidParameter`] for anything else.
-pub(crate) fn param_bool(options: &FairOptions, key: &str, default: bool) -> Result<bool> {
-    match options
-        .params
-        .get(key)
-        .map(|s| s.trim().to_ascii_lowercase())
-    {
-        None => Ok(default),
-        Some(s) => match s.as_str() {
-            "true" | "yes" | "1" | "on" => Ok(true),
-            "false" | "no" | "0" | "off" => Ok(false),
-            _ => Err(Error::InvalidParameter {
-                name: key.into(),
-                reason: format!("'{s}' is not a boolean (true/false)"),
-            }),
-        },
-    }
 }
 
 /// Point input fitted with a B-spline, and what the fit means for the tolerance.
@@ -510,25 +483,25 @@ pub(crate) fn fit_input(input: &PointSeq, options: &FairOptions) -> Result<Fitte
     let degree = fit_degree(options)?;
     let mut notes = Vec::new();
     let mut parameters = serde_json::Map::new();
-    let (curve, params, fit) = match options.params.get("control_points").map(|s| s.trim()) {
-        None | Some("auto") => {
-            let (c, t) = BSplineCurve::interpolate(points, degree, Parametrization::ChordLength)?;
-            (c, t, "interpolation")
-        }
-        Some(_) => {
-            let n =
-                options.param_usize_in("control_points", points.len(), degree + 1, points.len())?;
-            let (c, t) =
-                BSplineCurve::approximate(points, degree, n, Parametrization::ChordLength)?;
-            (c, t, "least_squares")
-        }
-    };
+    let (curve, params, fit) =
+        match options.param_auto_usize_in("control_points", degree + 1, points.len())? {
+            None => {
+                let (c, t) =
+                    BSplineCurve::interpolate(points, degree, Parametrization::ChordLength)?;
+                (c, t, "interpolation")
+            }
+            Some(n) => {
+                let (c, t) =
+                    BSplineCurve::approximate(points, degree, n, Parametrization::ChordLength)?;
+                (c, t, "least_squares")
+            }
+        };
     let residual = points
         .iter()
         .zip(&params)
         .map(|(q, &t)| q.distance(curve.eval(t)))
         .fold(0.0, f64::max);
-    let free = param_bool(options, "free_ends", false)?;
+    let free = options.param_bool("free_ends", false)?;
     if free && options.fix_ends.is_fixed() {
         notes.push("free_ends is ignored because the ends are fixed (--fix-ends)".to_string());
     }
@@ -596,7 +569,7 @@ pub(crate) fn curve_input(
     let params = curve.knots().greville(p);
     let seq = PointSeq::open(params.iter().map(|&t| curve.eval(t)).collect())?;
     let mut notes = Vec::new();
-    let free = param_bool(options, "free_ends", false)?;
+    let free = options.param_bool("free_ends", false)?;
     let free_ends = free && !options.fix_ends.is_fixed();
     let delta = match options.tolerance {
         Some(tol) => tol,

@@ -25,6 +25,8 @@ mod report;
 pub mod salvi;
 pub mod sapidis_farin;
 pub mod smoothing;
+mod smoothing_mst;
+mod space;
 
 use std::time::Instant;
 
@@ -45,14 +47,18 @@ pub use report::{
 pub use salvi::Salvi;
 pub use sapidis_farin::{SapidisFarin, remove_reinsert_knot};
 pub use smoothing::{Mst, Smoothing, SmoothingInfo, SmoothingSpline, SmoothingTrial};
+pub use space::{
+    FairedSpace, SPACE_METHODS, SpaceFairReport, SpaceOutcome, check_space_method, fair_space,
+};
 
 use crate::analysis::{FairnessMetrics, displacement, noise_sigma};
 use crate::error::{Error, Result};
-use crate::geom::{Point, PointSeq, Vec2};
+use crate::geom::{Point, PointSeq, SpaceSeq, Vec2};
 use crate::spline::BSplineCurve;
 
 /// What a method computed, before the common parts of the report are filled in.
 #[derive(Clone, Debug, Default)]
+#[non_exhaustive]
 pub struct Outcome {
     /// The faired points: same count and order as the input.
     pub points: Vec<Point>,
@@ -74,6 +80,10 @@ pub struct Outcome {
     pub tangents: Option<Vec<Vec2>>,
     /// The solver's figures, for methods that solve an optimisation problem.
     pub solver: Option<SolverInfo>,
+    /// What the method held at the ends of an open curve when that is more than
+    /// `--fix-ends` asked (`han` and `cali` always keep the end points); the report's
+    /// `fix_ends` and `fixed_ends` say what was held.
+    pub ends_held: Option<EndFix>,
 }
 
 /// A fairing method. Implementations are stateless unit structs.
@@ -115,6 +125,19 @@ pub trait FairMethod: Sync {
 
     /// Whether [`FairMethod::run_curve`] is implemented (B-spline input accepted).
     fn run_curve_supported(&self) -> bool {
+        false
+    }
+
+    /// Fair a space curve ([`fair_space`]): the faired 3-D points and what the method did.
+    /// `options` carries the resolved tolerance, as for [`FairMethod::run`]. `None` (the
+    /// default): the method is planar by nature.
+    fn run_space(&self, input: &SpaceSeq, options: &FairOptions) -> Option<Result<SpaceOutcome>> {
+        let _ = (input, options);
+        None
+    }
+
+    /// Whether [`FairMethod::run_space`] is implemented (space curves accepted).
+    fn run_space_supported(&self) -> bool {
         false
     }
 
@@ -165,6 +188,7 @@ pub trait FairMethod: Sync {
 
 /// The result of [`fair`]: the faired points and the report.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct Faired {
     /// The faired points, same count and order as the input.
     pub points: Vec<Point>,
@@ -289,19 +313,14 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
     let before = FairnessMetrics::of_seq(&in_unit(input, unit_scale)?)?;
     let start = Instant::now();
     let sigma = noise_sigma(input.points(), input.is_closed());
-    let (resolved, source) = resolve_tolerance(m, options, sigma, input)?;
+    let (resolved, source) =
+        resolve_tolerance(m, options, sigma, input.bbox().diagonal(), input.len())?;
     let options = &resolved;
-    let held = options.fix_ends.held();
-    let outcome = if !input.is_closed() && 2 * held >= input.len() {
-        // Every point is held: nothing may move.
+    let outcome = if let Some(note) = all_held(options, input.len(), input.is_closed()) {
         Outcome {
             points: input.points().to_vec(),
             status: FairStatus::NoChange,
-            notes: vec![format!(
-                "--fix-ends={} holds {held} points at each end, so all {} points stay",
-                options.fix_ends,
-                input.len()
-            )],
+            notes: vec![note],
             ..Outcome::default()
         }
     } else {
@@ -332,16 +351,28 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
 /// a positive number a method can scale by.
 const AUTO_TOLERANCE_FLOOR_REL: f64 = 1e-12;
 
+/// When `fix_ends` holds every point of an open curve of `n` points: the note that says so
+/// (nothing may move, the input is returned unchanged).
+fn all_held(options: &FairOptions, n: usize, closed: bool) -> Option<String> {
+    let held = options.fix_ends.held();
+    (!closed && 2 * held >= n).then(|| {
+        format!(
+            "--fix-ends={} holds {held} points at each end, so all {n} points stay",
+            options.fix_ends
+        )
+    })
+}
+
 /// The options with the tolerance the run uses, and where it came from: the given one, or
 /// `k·σ̂` when [`FairOptions::auto_tolerance`] is set (or the method defaults to it) and no
-/// tolerance was given.
+/// tolerance was given. `diagonal` (the bounding box's) and `n` are the input's.
 fn resolve_tolerance(
     m: &dyn FairMethod,
     options: &FairOptions,
     sigma: f64,
-    input: &PointSeq,
+    diagonal: f64,
+    n: usize,
 ) -> Result<(FairOptions, Option<ToleranceSource>)> {
-    let diagonal = input.bbox().diagonal();
     let mut resolved = options.clone();
     if options.tolerance.is_some() {
         return Ok((resolved, Some(ToleranceSource::Given)));
@@ -349,7 +380,7 @@ fn resolve_tolerance(
     if !(options.auto_tolerance || m.auto_tolerance_by_default()) {
         return Ok((resolved, None));
     }
-    let k = m.auto_tolerance_factor(options, input.len())?;
+    let k = m.auto_tolerance_factor(options, n)?;
     let floor = AUTO_TOLERANCE_FLOOR_REL * diagonal.max(f64::MIN_POSITIVE);
     resolved.tolerance = Some((k * sigma).max(floor));
     resolved.auto_tolerance = false;
@@ -474,10 +505,7 @@ fn finish(
             parameters: outcome.parameters,
             notes: {
                 let mut notes = outcome.notes;
-                notes.push(format!(
-                    "the result had {why} than the input, so the input is returned unchanged \
-                     (the clean-curve guard; keep_clean = false turns it off)"
-                ));
+                notes.push(guard::guard_note(&why));
                 notes
             },
             curve: curve.cloned(),
@@ -489,20 +517,20 @@ fn finish(
     let (before, after) = (before.rescaled(unit_scale), after.rescaled(unit_scale));
     let end_changes = end_changes(input, &faired);
     let disp = displacement(input.points(), &outcome.points)?;
-    let tolerance_met = options.tolerance.is_none_or(|d| disp.max <= d);
     let mut status = outcome.status;
     let mut notes = outcome.notes;
-    if input.is_closed() && options.fix_ends.is_fixed() {
-        notes.push("fix_ends has no effect on a closed curve (it has no ends)".to_string());
-    }
-    if !tolerance_met {
-        status = FairStatus::ToleranceExceeded;
-        notes.push(format!(
-            "the largest displacement {:.6e} exceeds the tolerance {:.6e}",
-            disp.max,
-            options.tolerance.unwrap_or(f64::NAN)
-        ));
-    }
+    let tolerance_met = verdict(
+        options,
+        input.is_closed(),
+        disp.max,
+        &mut status,
+        &mut notes,
+    );
+    let fixed_ends = if input.is_closed() {
+        options.fix_ends
+    } else {
+        options.fix_ends.max(outcome.ends_held.unwrap_or_default())
+    };
     let report = FairReport {
         method: m.name().to_string(),
         status,
@@ -516,8 +544,8 @@ fn finish(
         tolerance_source,
         noise_sigma,
         tolerance_met,
-        fix_ends: options.fix_ends.is_fixed(),
-        fixed_ends: options.fix_ends,
+        fix_ends: fixed_ends.is_fixed(),
+        fixed_ends,
         end_changes,
         before,
         after,
@@ -533,6 +561,32 @@ fn finish(
         curve: outcome.curve,
         tangents: outcome.tangents,
     })
+}
+
+/// The tolerance verdict every report shares: whether the largest displacement `max` is
+/// within the tolerance (always without one); when not, the status becomes
+/// `tolerance_exceeded` and a note says by how much. A note also says that `fix_ends` does
+/// nothing on a closed curve.
+fn verdict(
+    options: &FairOptions,
+    closed: bool,
+    max: f64,
+    status: &mut FairStatus,
+    notes: &mut Vec<String>,
+) -> bool {
+    let met = options.tolerance.is_none_or(|d| max <= d);
+    if closed && options.fix_ends.is_fixed() {
+        notes.push("fix_ends has no effect on a closed curve (it has no ends)".to_string());
+    }
+    if !met {
+        *status = FairStatus::ToleranceExceeded;
+        notes.push(format!(
+            "the largest displacement {:.6e} exceeds the tolerance {:.6e}",
+            max,
+            options.tolerance.unwrap_or(f64::NAN)
+        ));
+    }
+    met
 }
 
 /// Scale a proposed set of moves back so that no point ends farther than `tolerance` from its

@@ -285,6 +285,52 @@ impl FairOptions {
         Ok(v)
     }
 
+    /// Whether the parameter `key` is left to the method: not given, or `auto`.
+    pub fn param_is_auto(&self, key: &str) -> bool {
+        matches!(self.params.get(key).map(|s| s.trim()), None | Some("auto"))
+    }
+
+    /// A number in `[lo, hi]`, or `None` when the parameter is not given or `auto`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a value that is not a number or out of range.
+    pub fn param_auto_f64_in(&self, key: &str, lo: f64, hi: f64) -> Result<Option<f64>> {
+        if self.param_is_auto(key) {
+            return Ok(None);
+        }
+        self.param_f64_in(key, lo, lo, hi).map(Some)
+    }
+
+    /// A count in `[lo, hi]`, or `None` when the parameter is not given or `auto`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a value that is not a count or out of range.
+    pub fn param_auto_usize_in(&self, key: &str, lo: usize, hi: usize) -> Result<Option<usize>> {
+        if self.param_is_auto(key) {
+            return Ok(None);
+        }
+        self.param_usize_in(key, lo, lo, hi).map(Some)
+    }
+
+    /// A boolean method parameter, with a default: `true/false`, `yes/no`, `1/0`, `on/off`
+    /// (any case), the same for every method.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for anything else.
+    pub fn param_bool(&self, key: &str, default: bool) -> Result<bool> {
+        match self.params.get(key).map(|s| s.trim().to_ascii_lowercase()) {
+            None => Ok(default),
+            Some(s) => match s.as_str() {
+                "true" | "yes" | "1" | "on" => Ok(true),
+                "false" | "no" | "0" | "off" => Ok(false),
+                _ => Err(Error::InvalidParameter {
+                    name: key.into(),
+                    reason: format!("'{s}' is not a boolean (true/false)"),
+                }),
+            },
+        }
+    }
+
     /// A parameter that must be one of `choices`, with a default.
     ///
     /// # Errors
@@ -342,6 +388,27 @@ pub struct ParamSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every method's boolean parameters take the same spellings (one parser).
+    #[test]
+    fn booleans_are_read_one_way() {
+        for (v, want) in [
+            ("true", true),
+            ("Yes", true),
+            ("1", true),
+            (" on ", true),
+            ("FALSE", false),
+            ("no", false),
+            ("0", false),
+            ("off", false),
+        ] {
+            let o = FairOptions::default().with_param("flag", v);
+            assert_eq!(o.param_bool("flag", !want).unwrap(), want, "{v}");
+        }
+        assert!(FairOptions::default().param_bool("flag", true).unwrap());
+        let bad = FairOptions::default().with_param("flag", "maybe");
+        assert!(bad.param_bool("flag", true).is_err());
+    }
 
     fn reason(o: &FairOptions) -> String {
         match o.validate() {

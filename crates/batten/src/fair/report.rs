@@ -26,6 +26,26 @@ pub enum FairStatus {
     NoChange,
 }
 
+impl FairStatus {
+    /// The name the report uses (`converged`, `iteration_limit`, …).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            FairStatus::Converged => "converged",
+            FairStatus::IterationLimit => "iteration_limit",
+            FairStatus::ToleranceLimited => "tolerance_limited",
+            FairStatus::ToleranceExceeded => "tolerance_exceeded",
+            FairStatus::Stalled => "stalled",
+            FairStatus::NoChange => "no_change",
+        }
+    }
+}
+
+impl std::fmt::Display for FairStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
 /// Where a run's tolerance came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -39,6 +59,7 @@ pub enum ToleranceSource {
 
 /// What an optimisation-based method's solver did (`band`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct SolverInfo {
     /// Interior-point iterations, over all passes.
     pub iterations: usize,
@@ -51,6 +72,7 @@ pub struct SolverInfo {
 
 /// One point move of a local method.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct Move {
     /// Iteration number (1-based) of the move.
     pub iteration: usize,
@@ -66,6 +88,7 @@ pub struct Move {
 
 /// One row of a per-iteration trace: the method's measure and the largest distance so far.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct HistoryRow {
     /// Iteration number.
     pub iteration: usize,
@@ -82,6 +105,7 @@ pub struct HistoryRow {
 /// curve's end tangent and curvature exactly, and the data points next to the ends may then
 /// move a little, which shows here.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct EndChanges {
     /// Angle between the old and the new end chord, in radians, at the start and the end.
     pub tangent_angle: [f64; 2],
@@ -92,6 +116,7 @@ pub struct EndChanges {
 
 /// What a fairing run did. Serialised as the `--report` JSON.
 #[derive(Clone, Debug, Serialize)]
+#[non_exhaustive]
 pub struct FairReport {
     /// Method name.
     pub method: String,
@@ -139,4 +164,27 @@ pub struct FairReport {
     pub solver: Option<SolverInfo>,
     /// Remarks for the user.
     pub notes: Vec<String>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::FairStatus;
+
+    /// The displayed names are the report's.
+    #[test]
+    fn status_names_are_the_serialised_ones() {
+        for s in [
+            FairStatus::Converged,
+            FairStatus::IterationLimit,
+            FairStatus::ToleranceLimited,
+            FairStatus::ToleranceExceeded,
+            FairStatus::Stalled,
+            FairStatus::NoChange,
+        ] {
+            assert_eq!(
+                serde_json::to_value(s).unwrap(),
+                serde_json::Value::from(s.to_string())
+            );
+        }
+    }
 }

@@ -947,6 +947,8 @@ fn run_fitted(
         notes,
         curve: Some(faired),
         tangents: None,
+        // Held end control points are the clamped curve's end points.
+        ends_held: (!params.free_ends).then_some(super::EndFix::Position),
     })
 }
 
@@ -969,18 +971,8 @@ fn salvi_params(
     tolerance: Option<f64>,
     free_ends: bool,
 ) -> Result<SalviParams> {
-    let samples = match options.params.get("samples").map(|s| s.trim()) {
-        None | Some("auto") => None,
-        Some(_) => {
-            Some(options.param_usize_in("samples", DEFAULT_SAMPLES, MIN_SAMPLES, MAX_SAMPLES)?)
-        }
-    };
-    let auto_usize = |key: &str, lo: usize| -> Result<Option<usize>> {
-        match options.params.get(key).map(|s| s.trim()) {
-            None | Some("auto") => Ok(None),
-            Some(_) => options.param_usize_in(key, lo, lo, MAX_SAMPLES).map(Some),
-        }
-    };
+    let samples = options.param_auto_usize_in("samples", MIN_SAMPLES, MAX_SAMPLES)?;
+    let auto_usize = |key: &str, lo: usize| options.param_auto_usize_in(key, lo, MAX_SAMPLES);
     let coefficients = auto_usize("target_coefficients", MIN_TARGET_COEFFICIENTS)?;
     let half_width = auto_usize("half_width", 0)?;
     let passes = options.param_usize_in("passes", DEFAULT_PASSES, 0, 1000)?;
@@ -992,7 +984,7 @@ fn salvi_params(
     Ok(SalviParams {
         samples,
         smoother,
-        pin_ends: local::param_bool(options, "pin_ends", false)?,
+        pin_ends: options.param_bool("pin_ends", false)?,
         tolerance,
         tabu_length: options.param_usize_in("tabu", DEFAULT_TABU_LENGTH, 0, 1000)?,
         max_iterations,

@@ -559,6 +559,9 @@ impl FairMethod for SapidisFarin {
             // The wrapped form of a closed curve is not a curve of its own: none is returned.
             curve: (!closed).then_some(state.curve),
             tangents: None,
+            // P_0 and P_1 (and their mirror at the other end) are held: the end points (the
+            // curve's end tangents too, but not the second points, which `tangent` means).
+            ends_held: Some(super::EndFix::Position),
         })
     }
 }

@@ -63,13 +63,12 @@
 //! `α_ref = tr R / tr(Qᵀ W⁻¹ Q)`, csaps's default ([`SmoothingSpline::default_p`]), and so
 //! behave the same at every scale.
 
-use serde_json::{Map, Value};
-
-use super::{FairMethod, FairOptions, FairStatus, HistoryRow, Outcome, ParamSpec};
+use super::FairOptions;
+pub use super::smoothing_mst::{Mst, p_at_scale};
 use crate::error::{Error, Result};
-use crate::geom::{Point, PointSeq, Vec2};
+use crate::geom::{Point, Vec2};
 use crate::numeric::{CyclicSymBanded, SymBanded, factorize_with_inverse_band, minimize_brent};
-use crate::spline::{ParametricCubic, Parametrization, parameters};
+use crate::spline::ParametricCubic;
 
 /// The bisection on `ln α` (tolerance mode) stops when the bracket `[α_lo, α_hi]` satisfies
 /// `α_hi / α_lo ≤ 1 + BISECTION_REL_PRECISION`.
@@ -185,7 +184,7 @@ impl SmoothingSpline {
 
     /// The periodic smoothing spline of a closed point sequence: `t` has one more entry than
     /// `points`, the parameter at which the curve returns to `P_0` (as
-    /// [`parameters`]`(…, closed = true)` returns). `p` must be in `(0, 1]`.
+    /// [`crate::spline::parameters`]`(…, closed = true)` returns). `p` must be in `(0, 1]`.
     ///
     /// # Errors
     /// As [`SmoothingSpline::fit`]; [`Error::TooFewPoints`] for fewer than 3 points.
@@ -212,36 +211,17 @@ impl SmoothingSpline {
         closed: bool,
         how: Smoothing,
     ) -> Result<(SmoothingSpline, SmoothingInfo)> {
-        let problem = Problem::new(t, points, weights, closed)?;
-        match how {
-            Smoothing::P(p) => {
-                check_p(p, closed)?;
-                let fit = problem.fit_p(p)?;
-                let info = SmoothingInfo {
-                    p,
-                    alpha: fit.alpha,
-                    gcv: None,
-                    degrees_of_freedom: None,
-                    trials: Vec::new(),
-                    converged: true,
-                    notes: Vec::new(),
-                };
-                Ok((problem.into_spline(fit), info))
-            }
-            Smoothing::MaxDisplacement {
-                tolerance,
-                max_steps,
-            } => {
-                if !(tolerance.is_finite() && tolerance > 0.0) {
-                    return Err(Error::InvalidParameter {
-                        name: "tolerance".into(),
-                        reason: format!("must be a positive finite number, got {tolerance}"),
-                    });
-                }
-                problem.search_tolerance(tolerance, max_steps)
-            }
-            Smoothing::Gcv => problem.search_gcv(),
-        }
+        let y: Vec<[f64; 2]> = points.iter().map(|p| [p.x, p.y]).collect();
+        let (fit, info) = select_any(t, &y, weights, closed, how)?;
+        let spline = SmoothingSpline {
+            t: t.to_vec(),
+            values: fit.values.iter().map(|g| Point::new(g[0], g[1])).collect(),
+            second: fit.second.iter().map(|c| Vec2::new(c[0], c[1])).collect(),
+            p: fit.p,
+            alpha: fit.alpha,
+            closed,
+        };
+        Ok((spline, info))
     }
 
     /// csaps's default smoothing parameter for these parameters and weights:
@@ -257,7 +237,7 @@ impl SmoothingSpline {
         } else {
             t.len()
         };
-        let dummy: Vec<Point> = vec![Point::ORIGIN; n];
+        let dummy = vec![[0.0; 2]; n];
         let problem = Problem::new(t, &dummy, Some(weights), closed)?;
         let alpha = problem.alpha_ref()?;
         Ok(1.0 / (1.0 + alpha))
@@ -302,7 +282,8 @@ impl SmoothingSpline {
 
     /// The roughness `∫ |C''(t)|² dt` (exact: C'' is piecewise linear).
     pub fn roughness(&self) -> f64 {
-        roughness(&self.t, &self.second, self.closed)
+        let second: Vec<[f64; 2]> = self.second.iter().map(|c| [c.x, c.y]).collect();
+        roughness(&self.t, &second, self.closed)
     }
 
     /// The spline itself, as a [`ParametricCubic`] through the smoothed values with the
@@ -337,11 +318,86 @@ impl SmoothingSpline {
     }
 }
 
+/// The smoothing spline of points of any dimension (one parameter and one p for every
+/// coordinate), with p chosen as `how` says: the fit and how p was chosen. As
+/// [`SmoothingSpline::select`], which is this for planar points.
+///
+/// # Errors
+/// As [`SmoothingSpline::select`].
+pub(crate) fn select_any<const D: usize>(
+    t: &[f64],
+    points: &[[f64; D]],
+    weights: Option<&[f64]>,
+    closed: bool,
+    how: Smoothing,
+) -> Result<(Fit<D>, SmoothingInfo)> {
+    let problem = Problem::new(t, points, weights, closed)?;
+    match how {
+        Smoothing::P(p) => {
+            check_p(p, closed)?;
+            let fit = problem.fit_p(p)?;
+            let info = SmoothingInfo {
+                p,
+                alpha: fit.alpha,
+                gcv: None,
+                degrees_of_freedom: None,
+                trials: Vec::new(),
+                converged: true,
+                notes: Vec::new(),
+            };
+            Ok((fit, info))
+        }
+        Smoothing::MaxDisplacement {
+            tolerance,
+            max_steps,
+        } => {
+            if !(tolerance.is_finite() && tolerance > 0.0) {
+                return Err(Error::InvalidParameter {
+                    name: "tolerance".into(),
+                    reason: format!("must be a positive finite number, got {tolerance}"),
+                });
+            }
+            problem.search_tolerance(tolerance, max_steps)
+        }
+        Smoothing::Gcv => problem.search_gcv(),
+    }
+}
+
+/// `a · b` (in 2-D as [`Vec2::dot`], bit for bit).
+fn dot<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
+    (1..D).fold(a[0] * b[0], |s, k| s + a[k] * b[k])
+}
+
+/// The distance `|a − b|` by `hypot`, as the fairing report measures it (in 2-D
+/// [`Point::distance`] bit for bit).
+fn distance<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
+    (1..D).fold((b[0] - a[0]).abs(), |s, k| s.hypot(b[k] - a[k]))
+}
+
+/// Solve for each coordinate of `rhs` in turn with `solve` (one factorisation, a scalar
+/// right-hand side each: the same numbers as solving for the planar vectors together).
+fn by_coordinate<const D: usize>(
+    rhs: &mut [[f64; D]],
+    solve: impl Fn(&mut [f64]) -> Result<()>,
+) -> Result<()> {
+    let mut column = vec![0.0; rhs.len()];
+    for c in 0..D {
+        for (x, v) in column.iter_mut().zip(rhs.iter()) {
+            *x = v[c];
+        }
+        solve(&mut column)?;
+        for (v, x) in rhs.iter_mut().zip(&column) {
+            v[c] = *x;
+        }
+    }
+    Ok(())
+}
+
 /// The largest `|g_i − y_i|`, measured as the fairing report measures it.
-fn max_displacement(y: &[Point], g: &[Point]) -> f64 {
+fn max_displacement<const D: usize>(y: &[[f64; D]], g: &[[f64; D]]) -> f64 {
     y.iter()
         .zip(g)
-        .map(|(a, b)| (*b - *a).length())
+        .map(|(a, b)| distance(a, b))
         .fold(0.0, f64::max)
 }
 
@@ -355,14 +411,11 @@ fn alpha_of(p: f64) -> f64 {
 }
 
 /// The `p` parameter: `None` for `auto` (or not given), else a number in [0, 1].
-fn param_p(options: &FairOptions) -> Result<Option<f64>> {
-    match options.params.get("p").map(|s| s.trim()) {
-        None | Some("auto") => Ok(None),
-        Some(_) => options.param_f64_in("p", 1.0, 0.0, 1.0).map(Some),
-    }
+pub(crate) fn param_p(options: &FairOptions) -> Result<Option<f64>> {
+    options.param_auto_f64_in("p", 0.0, 1.0)
 }
 
-fn check_p(p: f64, closed: bool) -> Result<()> {
+pub(crate) fn check_p(p: f64, closed: bool) -> Result<()> {
     if !(0.0..=1.0).contains(&p) {
         return Err(Error::InvalidParameter {
             name: "p".into(),
@@ -379,26 +432,27 @@ fn check_p(p: f64, closed: bool) -> Result<()> {
 }
 
 /// `∫ |C''|² dt` for C'' piecewise linear through `second` at the knots `t`.
-fn roughness(t: &[f64], second: &[Vec2], closed: bool) -> f64 {
+pub(crate) fn roughness<const D: usize>(t: &[f64], second: &[[f64; D]], closed: bool) -> f64 {
     let n = second.len();
     let spans = if closed { n } else { n.saturating_sub(1) };
     (0..spans)
         .map(|i| {
-            let (a, b) = (second[i], second[(i + 1) % n]);
-            (t[i + 1] - t[i]) * (a.dot(a) + a.dot(b) + b.dot(b)) / 3.0
+            let (a, b) = (&second[i], &second[(i + 1) % n]);
+            (t[i + 1] - t[i]) * (dot(a, a) + dot(a, b) + dot(b, b)) / 3.0
         })
         .sum()
 }
 
 /// One solved spline: the fitted values, `u` (with `γ = p·u`) at every knot, and the
 /// quantities the searches need.
-struct Fit {
-    p: f64,
+pub(crate) struct Fit<const D: usize> {
+    pub(crate) p: f64,
     /// `α = (1 − p)/p` as used (kept apart from p, which rounds to 1 for tiny α).
-    alpha: f64,
-    values: Vec<Point>,
+    pub(crate) alpha: f64,
+    /// The smoothed values `g_i`.
+    pub(crate) values: Vec<[f64; D]>,
     /// `C''(t_k)` at every knot.
-    second: Vec<Vec2>,
+    pub(crate) second: Vec<[f64; D]>,
     /// `Σ w_i |y_i − g_i|²` (GCV only).
     rss: f64,
     /// `tr(I − A)` (GCV only).
@@ -406,9 +460,9 @@ struct Fit {
 }
 
 /// The data of one smoothing problem, validated, with what every trial shares.
-struct Problem<'a> {
+struct Problem<'a, const D: usize> {
     t: &'a [f64],
-    y: &'a [Point],
+    y: &'a [[f64; D]],
     closed: bool,
     /// `W⁻¹_ii` (0 for a pinned point); `None` for unit weights.
     dinv: Option<Vec<f64>>,
@@ -416,13 +470,13 @@ struct Problem<'a> {
     ih: Vec<f64>,
 }
 
-impl<'a> Problem<'a> {
+impl<'a, const D: usize> Problem<'a, D> {
     fn new(
         t: &'a [f64],
-        y: &'a [Point],
+        y: &'a [[f64; D]],
         weights: Option<&[f64]>,
         closed: bool,
-    ) -> Result<Problem<'a>> {
+    ) -> Result<Problem<'a, D>> {
         let n = y.len();
         let min = if closed { 3 } else { 2 };
         if n < min {
@@ -445,7 +499,7 @@ impl<'a> Problem<'a> {
         if let Some(i) = t.windows(2).position(|w| w[1] <= w[0]) {
             return Err(Error::NotIncreasing { index: i + 1 });
         }
-        if let Some(index) = y.iter().position(|p| !p.is_finite()) {
+        if let Some(index) = y.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
             return Err(Error::NonFinite { index });
         }
         let dinv = match weights {
@@ -491,9 +545,10 @@ impl<'a> Problem<'a> {
 
     /// `(Qᵀ y)` at knot k: the jump of the divided differences.
     #[inline]
-    fn qty(&self, k: usize) -> Vec2 {
+    fn qty(&self, k: usize) -> [f64; D] {
         let (km, kp) = (self.prev(k), self.next(k));
-        (self.y[kp] - self.y[k]) * self.ih[k] - (self.y[k] - self.y[km]) * self.ih[km]
+        let (y, ih) = (self.y, &self.ih);
+        std::array::from_fn(|a| (y[kp][a] - y[k][a]) * ih[k] - (y[k][a] - y[km][a]) * ih[km])
     }
 
     fn n(&self) -> usize {
@@ -568,7 +623,7 @@ impl<'a> Problem<'a> {
     }
 
     /// Solve for `p ∈ [0, 1]` (p = 0 by the least-squares line on open curves).
-    fn fit_p(&self, p: f64) -> Result<Fit> {
+    fn fit_p(&self, p: f64) -> Result<Fit<D>> {
         if p == 0.0 {
             self.fit_line()
         } else {
@@ -577,7 +632,7 @@ impl<'a> Problem<'a> {
     }
 
     /// Solve for `α` given on a log scale, `α = α_ref · e^s`.
-    fn fit_log_alpha(&self, alpha_ref: f64, s: f64, gcv: bool) -> Result<Fit> {
+    fn fit_log_alpha(&self, alpha_ref: f64, s: f64, gcv: bool) -> Result<Fit<D>> {
         let alpha = alpha_ref * s.exp();
         self.solve(1.0 / (1.0 + alpha), alpha / (1.0 + alpha), alpha, gcv)
     }
@@ -585,10 +640,10 @@ impl<'a> Problem<'a> {
     /// The spline for the scaled system `(a R + b Qᵀ W⁻¹ Q) u = Qᵀ y` (`a = p`, `b = 1 − p`,
     /// `alpha = b/a` computed by the caller without rounding p);
     /// with `gcv`, also RSS and `tr(I − A)`.
-    fn solve(&self, a: f64, b: f64, alpha: f64, gcv: bool) -> Result<Fit> {
+    fn solve(&self, a: f64, b: f64, alpha: f64, gcv: bool) -> Result<Fit<D>> {
         let (n, m) = (self.n(), self.m());
         // u at every knot; the open ends stay 0 (natural end conditions).
-        let mut u = vec![Vec2::ZERO; n];
+        let mut u = vec![[0.0; D]; n];
         let mut trace_residual = 0.0;
         if self.closed {
             let mut mat = CyclicSymBanded::zeros(m, 2);
@@ -605,7 +660,7 @@ impl<'a> Problem<'a> {
             } else {
                 mat.factorize()?;
             }
-            mat.solve_in_place(&mut u)?;
+            by_coordinate(&mut u, |c| mat.solve_in_place(c))?;
         } else {
             let mut mat = SymBanded::zeros(m, 2);
             for j in 0..m {
@@ -625,21 +680,24 @@ impl<'a> Problem<'a> {
             } else {
                 mat.factorize()?;
             }
-            mat.solve_in_place(&mut u[1..n - 1])?;
+            by_coordinate(&mut u[1..n - 1], |c| mat.solve_in_place(c))?;
         }
         let mut values = Vec::with_capacity(n);
         let mut rss = 0.0;
         for i in 0..n {
             let qu = self.q_row_times(&u, i);
             let di = self.d(i);
-            values.push(self.y[i] - qu * (b * di));
+            let yi = self.y[i];
+            values.push(std::array::from_fn(|c| yi[c] - qu[c] * (b * di)));
             if gcv {
                 // w_i |y_i − g_i|² = b² D_i |(Qu)_i|², exact even where g_i ≈ y_i.
-                rss += b * b * di * qu.length_squared();
+                rss += b * b * di * dot(&qu, &qu);
             }
         }
         for v in &mut u {
-            *v *= a;
+            for c in v.iter_mut() {
+                *c *= a;
+            }
         }
         Ok(Fit {
             p: a,
@@ -653,17 +711,19 @@ impl<'a> Problem<'a> {
 
     /// `(Q v)_i` for `v` given at every knot (zero at the open ends).
     #[inline]
-    fn q_row_times(&self, v: &[Vec2], i: usize) -> Vec2 {
+    fn q_row_times(&self, v: &[[f64; D]], i: usize) -> [f64; D] {
         let n = self.n();
+        let ih = &self.ih;
+        let term = |j: usize, h: usize, c: usize| (v[j][c] - v[i][c]) * ih[h];
         if self.closed {
             let (im, ip) = (self.prev(i), self.next(i));
-            (v[im] - v[i]) * self.ih[im] + (v[ip] - v[i]) * self.ih[i]
+            std::array::from_fn(|c| term(im, im, c) + term(ip, i, c))
         } else if i == 0 {
-            (v[1] - v[0]) * self.ih[0]
+            std::array::from_fn(|c| term(1, 0, c))
         } else if i == n - 1 {
-            (v[i - 1] - v[i]) * self.ih[i - 1]
+            std::array::from_fn(|c| term(i - 1, i - 1, c))
         } else {
-            (v[i - 1] - v[i]) * self.ih[i - 1] + (v[i + 1] - v[i]) * self.ih[i]
+            std::array::from_fn(|c| term(i - 1, i - 1, c) + term(i + 1, i, c))
         }
     }
 
@@ -712,30 +772,36 @@ impl<'a> Problem<'a> {
 
     /// p = 0 on an open curve: the weighted least-squares line in t, constrained through the
     /// pinned points (at most two).
-    fn fit_line(&self) -> Result<Fit> {
+    fn fit_line(&self) -> Result<Fit<D>> {
         let n = self.n();
         let pins: Vec<usize> = (0..n).filter(|&i| self.d(i) == 0.0).collect();
         let t = self.t;
         // The line is `origin + slope · (t − t_origin)`.
         let (t_origin, origin, slope) = match pins.as_slice() {
             [] => {
-                let (mut sw, mut st, mut sy) = (0.0, 0.0, Vec2::ZERO);
+                let (mut sw, mut st, mut sy) = (0.0, 0.0, [0.0; D]);
                 for (i, (&ti, yi)) in t.iter().zip(self.y).enumerate() {
                     let w = 1.0 / self.d(i);
                     sw += w;
                     st += w * ti;
-                    sy += yi.to_vec2() * w;
+                    for c in 0..D {
+                        sy[c] += yi[c] * w;
+                    }
                 }
-                let (tm, ym) = (st / sw, sy / sw);
+                let (tm, ym) = (st / sw, sy.map(|v| v / sw));
                 (tm, ym, self.slope_about(tm, ym, None))
             }
             &[k] => {
-                let (tk, yk) = (t[k], self.y[k].to_vec2());
+                let (tk, yk) = (t[k], self.y[k]);
                 (tk, yk, self.slope_about(tk, yk, Some(k)))
             }
             &[k0, k1] => {
-                let (t0, y0) = (t[k0], self.y[k0].to_vec2());
-                (t0, y0, (self.y[k1].to_vec2() - y0) / (t[k1] - t0))
+                let (t0, y0, y1) = (t[k0], self.y[k0], self.y[k1]);
+                (
+                    t0,
+                    y0,
+                    std::array::from_fn(|c| (y1[c] - y0[c]) / (t[k1] - t0)),
+                )
             }
             _ => {
                 return Err(Error::InvalidParameter {
@@ -751,18 +817,18 @@ impl<'a> Problem<'a> {
             let g = if self.d(i) == 0.0 {
                 yi
             } else {
-                (origin + slope * (ti - t_origin)).to_point()
+                std::array::from_fn(|c| origin[c] + slope[c] * (ti - t_origin))
             };
             values.push(g);
         }
-        if values.iter().any(|g| !g.is_finite()) {
+        if values.iter().flatten().any(|g| !g.is_finite()) {
             return Err(Error::Singular("least-squares line is not finite".into()));
         }
         Ok(Fit {
             p: 0.0,
             alpha: f64::INFINITY,
             values,
-            second: vec![Vec2::ZERO; n],
+            second: vec![[0.0; D]; n],
             rss: 0.0,
             trace_residual: 0.0,
         })
@@ -770,29 +836,20 @@ impl<'a> Problem<'a> {
 
     /// The weighted least-squares slope of the points about the fixed `(t0, y0)`, leaving out
     /// point `skip`.
-    fn slope_about(&self, t0: f64, y0: Vec2, skip: Option<usize>) -> Vec2 {
-        let (mut stt, mut sty) = (0.0, Vec2::ZERO);
+    fn slope_about(&self, t0: f64, y0: [f64; D], skip: Option<usize>) -> [f64; D] {
+        let (mut stt, mut sty) = (0.0, [0.0; D]);
         for i in (0..self.n()).filter(|&i| Some(i) != skip) {
             let w = 1.0 / self.d(i);
             let dt = self.t[i] - t0;
             stt += w * dt * dt;
-            sty += (self.y[i].to_vec2() - y0) * (w * dt);
+            for c in 0..D {
+                sty[c] += (self.y[i][c] - y0[c]) * (w * dt);
+            }
         }
-        sty / stt
+        sty.map(|v| v / stt)
     }
 
-    fn into_spline(self, fit: Fit) -> SmoothingSpline {
-        SmoothingSpline {
-            t: self.t.to_vec(),
-            values: fit.values,
-            second: fit.second,
-            p: fit.p,
-            alpha: fit.alpha,
-            closed: self.closed,
-        }
-    }
-
-    fn trial(&self, fit: &Fit, gcv: Option<f64>) -> SmoothingTrial {
+    fn trial(&self, fit: &Fit<D>, gcv: Option<f64>) -> SmoothingTrial {
         SmoothingTrial {
             p: fit.p,
             alpha: fit.alpha,
@@ -813,11 +870,11 @@ impl<'a> Problem<'a> {
     /// The result of tolerance mode.
     fn finish(
         self,
-        fit: Fit,
+        fit: Fit<D>,
         trials: Vec<SmoothingTrial>,
         converged: bool,
         notes: Vec<String>,
-    ) -> Result<(SmoothingSpline, SmoothingInfo)> {
+    ) -> Result<(Fit<D>, SmoothingInfo)> {
         let info = SmoothingInfo {
             p: fit.p,
             alpha: fit.alpha,
@@ -827,15 +884,11 @@ impl<'a> Problem<'a> {
             converged,
             notes,
         };
-        Ok((self.into_spline(fit), info))
+        Ok((fit, info))
     }
 
     /// Tolerance mode: bisection on `ln α` for the largest feasible α.
-    fn search_tolerance(
-        self,
-        tolerance: f64,
-        max_steps: usize,
-    ) -> Result<(SmoothingSpline, SmoothingInfo)> {
+    fn search_tolerance(self, tolerance: f64, max_steps: usize) -> Result<(Fit<D>, SmoothingInfo)> {
         let mut trials = Vec::new();
         let mut notes = Vec::new();
         // The smoothest candidate of an open curve: the least-squares line.
@@ -852,7 +905,7 @@ impl<'a> Problem<'a> {
                 Err(_) => {} // more than two pins: no line candidate
             }
         }
-        let interpolant = |problem: &Problem<'_>| problem.solve(1.0, 0.0, 0.0, false);
+        let interpolant = |problem: &Problem<'_, D>| problem.solve(1.0, 0.0, 0.0, false);
         if self.m() == 0 {
             let fit = interpolant(&self)?;
             return self.finish(fit, trials, true, notes);
@@ -860,7 +913,7 @@ impl<'a> Problem<'a> {
         let alpha_ref = self.alpha_ref()?;
         let (mut lo, mut hi) = self.log_alpha_range();
         let y = self.y;
-        let feasible = |fit: &Result<Fit>| {
+        let feasible = |fit: &Result<Fit<D>>| {
             fit.as_ref()
                 .is_ok_and(|f| max_displacement(y, &f.values) <= tolerance)
         };
@@ -917,7 +970,7 @@ impl<'a> Problem<'a> {
     }
 
     /// GCV mode: coarse scan of `ln α`, then Brent around the best scan point.
-    fn search_gcv(self) -> Result<(SmoothingSpline, SmoothingInfo)> {
+    fn search_gcv(self) -> Result<(Fit<D>, SmoothingInfo)> {
         if self.n() < 3 {
             return Err(Error::TooFewPoints {
                 needed: 3,
@@ -984,171 +1037,6 @@ impl<'a> Problem<'a> {
             converged,
             notes,
         };
-        Ok((self.into_spline(fit), info))
+        Ok((fit, info))
     }
-}
-
-/// The parameter list of [`Mst`].
-static PARAMS: &[ParamSpec] = &[ParamSpec {
-    name: "p",
-    default: "auto",
-    doc: "smoothing parameter in [0, 1] (1 interpolates, 0 is the least-squares line); \
-          auto: the smoothest within --tolerance, else generalised cross-validation",
-}];
-
-/// The `mst` fairing method: the cubic smoothing spline of the points at chord-length
-/// parameters, with p given (`--set p=…`), chosen for `--tolerance`, or by GCV. See the module
-/// documentation for the equations and [`SmoothingSpline`] for the library API.
-///
-/// Reports `p`, `alpha`, `selection` (`given`, `tolerance`, `gcv`), `roughness` and, for GCV,
-/// `gcv` and `degrees_of_freedom` in [`Outcome::parameters`]; iterations are the splines the
-/// search computed (bisection steps or GCV evaluations). [`Outcome::curve`] is left empty: the
-/// method's product is the points, and building the curve would triple its cost at 10⁶
-/// points; the library's [`SmoothingSpline::curve`] gives the spline itself
-/// (`BSplineCurve::from_parametric_cubic` turns it into exact B-spline form).
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Mst;
-
-/// The smoothing parameter that gives the same curve when the data (points and chord-length
-/// parameters) are multiplied by `f`: the objective `p·Σ|y − f|² + (1 − p)·∫|f''|² dt`
-/// becomes `p·f²·Σ + (1 − p)/f·∫`, so the ratio `(1 − p)/p` is divided by `f³`. Exact in
-/// real arithmetic; the limits p → 1 (interpolation) and p → 0 (the line) are kept.
-pub fn p_at_scale(p: f64, f: f64) -> f64 {
-    if p <= 0.0 || p >= 1.0 {
-        return p;
-    }
-    // One factor at a time: f³ alone may overflow where the ratio does not.
-    let ratio = (1.0 - p) / p / f / f / f;
-    1.0 / (1.0 + ratio)
-}
-
-impl FairMethod for Mst {
-    fn name(&self) -> &'static str {
-        "mst"
-    }
-
-    fn description(&self) -> &'static str {
-        "cubic smoothing spline (Reinsch / de Boor SMOOTH, Matlab csaps; Han et al.'s MST): \
-         p given, else the smoothest within the tolerance, else GCV"
-    }
-
-    fn parameters(&self) -> &'static [ParamSpec] {
-        PARAMS
-    }
-
-    fn supports_closed(&self) -> bool {
-        true
-    }
-
-    fn keeps_clean(&self) -> bool {
-        // The csaps baseline: its result must stay equal to csaps'.
-        false
-    }
-
-    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
-        let mut o = options.clone();
-        if let Some(p) = param_p(options)? {
-            o.params
-                .insert("p".into(), format!("{:e}", p_at_scale(p, 1.0 / s)));
-        }
-        Ok(o)
-    }
-
-    fn report_params_at_scale(
-        &self,
-        parameters: &mut serde_json::Map<String, serde_json::Value>,
-        s: f64,
-    ) {
-        if let Some(p) = parameters.get("p").and_then(serde_json::Value::as_f64) {
-            parameters.insert("p".into(), json_f64(p_at_scale(p, s)));
-        }
-    }
-
-    fn check_params(&self, options: &FairOptions) -> Result<()> {
-        param_p(options).map(|_| ())
-    }
-
-    fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
-        let points = input.points();
-        let closed = input.is_closed();
-        let n = points.len();
-        let t = parameters(points, Parametrization::ChordLength, closed)?;
-        let p = param_p(options)?;
-        if let Some(p) = p {
-            check_p(p, closed)?;
-        }
-        let mut notes = Vec::new();
-        let weights: Option<Vec<f64>> = if options.fix_ends.is_fixed() && !closed {
-            // Pin the held points at each end (one for the position, two for the tangent,
-            // three for the curvature).
-            let held = options.fix_ends.held().min(n / 2);
-            let mut w = vec![1.0; n];
-            w[..held].fill(f64::INFINITY);
-            w[n - held..].fill(f64::INFINITY);
-            Some(w)
-        } else {
-            None
-        };
-        let (how, selection) = match (p, options.tolerance) {
-            (Some(p), tol) => {
-                if tol.is_some() {
-                    notes.push("p was given, so the tolerance does not choose it".to_string());
-                }
-                (Smoothing::P(p), "given")
-            }
-            (None, Some(tolerance)) => (
-                Smoothing::MaxDisplacement {
-                    tolerance,
-                    max_steps: options.iterations_or(DEFAULT_MAX_BISECTION_STEPS),
-                },
-                "tolerance",
-            ),
-            (None, None) => (Smoothing::Gcv, "gcv"),
-        };
-        let (spline, info) = SmoothingSpline::select(&t, points, weights.as_deref(), closed, how)?;
-        let mut parameters = Map::new();
-        parameters.insert("p".into(), json_f64(info.p));
-        parameters.insert("alpha".into(), json_f64(info.alpha));
-        parameters.insert("selection".into(), Value::from(selection));
-        if let Some(g) = info.gcv {
-            parameters.insert("gcv".into(), json_f64(g));
-        }
-        if let Some(d) = info.degrees_of_freedom {
-            parameters.insert("degrees_of_freedom".into(), json_f64(d));
-        }
-        parameters.insert("roughness".into(), json_f64(spline.roughness()));
-        let mut history = Vec::new();
-        if matches!(how, Smoothing::MaxDisplacement { .. }) {
-            history = info
-                .trials
-                .iter()
-                .enumerate()
-                .map(|(k, tr)| HistoryRow {
-                    iteration: k + 1,
-                    measure: tr.roughness,
-                    max_distance: tr.max_displacement,
-                })
-                .collect();
-        }
-        let status = if info.converged {
-            FairStatus::Converged
-        } else {
-            FairStatus::IterationLimit
-        };
-        notes.extend(info.notes);
-        Ok(Outcome {
-            iterations: info.trials.len(),
-            points: spline.into_values(),
-            status,
-            parameters,
-            history,
-            notes,
-            ..Outcome::default()
-        })
-    }
-}
-
-/// A JSON number, or `null` for a non-finite value (JSON has no infinity).
-fn json_f64(v: f64) -> Value {
-    serde_json::Number::from_f64(v).map_or(Value::Null, Value::Number)
 }

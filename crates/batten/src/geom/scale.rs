@@ -8,7 +8,7 @@
 //! centre would round every coordinate, and it is overflow and underflow, not the position,
 //! that breaks computations at extreme magnitudes.
 
-use super::Point;
+use super::{Point, Xyz};
 
 /// The power of two nearest to the larger side of the bounding box of `points`: dividing
 /// by it brings the larger side into `[2^-0.5, 2^0.5]`. `1.0` for fewer than two distinct
@@ -21,6 +21,26 @@ pub fn unit_scale(points: &[Point]) -> f64 {
     }
     // Half-extents, so that ±f64::MAX does not overflow the subtraction.
     let extent = (0.5 * hi[0] - 0.5 * lo[0]).max(0.5 * hi[1] - 0.5 * lo[1]);
+    scale_of_half_extent(extent)
+}
+
+/// [`unit_scale`] for points in space: the largest side of their bounding box.
+pub fn unit_scale_xyz(points: &[Xyz]) -> f64 {
+    let mut extent = 0.0_f64;
+    for a in 0..3 {
+        let (lo, hi) = points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p[a]), hi.max(p[a]))
+            });
+        // Half-extents, so that ±f64::MAX does not overflow the subtraction.
+        extent = extent.max(0.5 * hi - 0.5 * lo);
+    }
+    scale_of_half_extent(extent)
+}
+
+/// The power of two for a bounding box whose larger side is `2·extent`.
+fn scale_of_half_extent(extent: f64) -> f64 {
     if !(extent.is_finite() && extent > 0.0) {
         return 1.0;
     }

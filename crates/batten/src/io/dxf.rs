@@ -9,30 +9,34 @@
 //!
 //! Which entity: the one with handle [`Pick::entity`], else the only one on layer
 //! [`Pick::layer`], else the only curve entity of the file; otherwise the error lists them.
-//! batten fairs planar curves: every point must have the same z, which is written back;
-//! a curve whose z varies, arc segments (bulges) and entities in an object coordinate
-//! system other than the world's (extrusion not +z) are refused.
+//! A curve whose points all have the same z is planar, and its z is written back; a 3-D
+//! `POLYLINE` or `SPLINE` fit points whose z varies are a space curve (`x, y, z` points). A
+//! `SPLINE` with control points whose z varies (a 3-D B-spline), arc segments (bulges) and
+//! entities in an object coordinate system other than the world's (extrusion not +z) are
+//! refused.
 //!
-//! Writing: points as an `LWPOLYLINE` with the elevation and layer of the input, a B-spline
-//! as a `SPLINE` (degree, knots, control points, weights; rational and closed flags), in an
-//! R2000 drawing. The `dxf` crate writes ASCII numbers with 12 decimal places, so a written
+//! Writing: points as an `LWPOLYLINE` with the elevation and layer of the input, space
+//! points as a 3-D `POLYLINE`, a B-spline as a `SPLINE` (degree, knots, control points,
+//! weights; rational and closed flags), in an R2000 drawing. The `dxf` crate writes ASCII numbers with 12 decimal places, so a written
 //! file reads back within 5·10⁻¹³ of each coordinate, not bit for bit.
 
 use std::path::Path;
 
-use dxf::entities::{Entity, EntityType, LwPolyline, Spline};
+use dxf::entities::{Entity, EntityType, LwPolyline, Polyline, Spline, Vertex};
 use dxf::enums::AcadVersion;
 use dxf::{Drawing, LwPolylineVertex};
 
 use super::error::one_line;
 use super::{IoError, Location, Origin, Pick, Raw, ReadOptions, Source, validated};
-use crate::geom::Point;
+use crate::geom::{Point, Xyz};
 use crate::spline::{BSplineCurve, KnotVector};
 
 /// POLYLINE flag: the vertices are 3-D.
 const POLYLINE_3D: i32 = 8;
 /// POLYLINE flags of meshes, which are not curves.
 const POLYLINE_MESH: i32 = 16 | 64;
+/// VERTEX flag: a vertex of a 3-D polyline.
+const VERTEX_3D: i32 = 32;
 /// VERTEX flag: a frame control point of a spline-fit polyline (not on the curve).
 const VERTEX_FRAME: i32 = 16;
 /// SPLINE flag: planar.
@@ -193,20 +197,32 @@ pub(crate) fn entity_curve(found: &Found<'_>, path: &Path) -> Result<(Raw, f64),
             )))
         }
     };
-    let planar = |zs: &mut dyn Iterator<Item = f64>| -> Result<f64, IoError> {
+    // The constant z, or the first two values that differ.
+    let planar = |zs: &mut dyn Iterator<Item = f64>| -> Result<f64, (f64, f64)> {
         let mut z0 = None;
         for z in zs {
             match z0 {
                 None => z0 = Some(z),
                 Some(a) if a == z => {}
-                Some(a) => {
-                    return Err(err(format!(
-                        "z varies ({a} and {z}): 3-D curves are not supported yet"
-                    )));
-                }
+                Some(a) => return Err((a, z)),
             }
         }
         Ok(z0.unwrap_or(0.0))
+    };
+    // Space points, a closed entity's repeated first vertex left out.
+    let space = |mut points: Vec<Xyz>, closed: bool| {
+        if closed && points.len() > 1 && points.last() == points.first() {
+            points.pop();
+        }
+        let lines = vec![1; points.len()];
+        Ok((
+            Raw::Space {
+                points,
+                lines,
+                closed,
+            },
+            0.0,
+        ))
     };
     match &e.specific {
         EntityType::LwPolyline(lw) => {
@@ -245,7 +261,16 @@ pub(crate) fn entity_curve(found: &Found<'_>, path: &Path) -> Result<(Raw, f64),
                 )));
             }
             let z = if pl.flags & POLYLINE_3D != 0 {
-                planar(&mut verts.iter().map(|v| v.location.z))?
+                match planar(&mut verts.iter().map(|v| v.location.z)) {
+                    Ok(z) => z,
+                    Err(_) => {
+                        let pts = verts
+                            .iter()
+                            .map(|v| [v.location.x, v.location.y, v.location.z])
+                            .collect();
+                        return space(pts, pl.is_closed());
+                    }
+                }
             } else {
                 pl.location.z
             };
@@ -270,7 +295,10 @@ pub(crate) fn entity_curve(found: &Found<'_>, path: &Path) -> Result<(Raw, f64),
         EntityType::Spline(sp) => {
             extrusion(&sp.normal)?;
             if sp.control_points.is_empty() {
-                let z = planar(&mut sp.fit_points.iter().map(|p| p.z))?;
+                let Ok(z) = planar(&mut sp.fit_points.iter().map(|p| p.z)) else {
+                    let pts = sp.fit_points.iter().map(|p| [p.x, p.y, p.z]).collect();
+                    return space(pts, sp.is_closed());
+                };
                 let mut points: Vec<Point> =
                     sp.fit_points.iter().map(|p| Point::new(p.x, p.y)).collect();
                 let closed = sp.is_closed();
@@ -287,7 +315,12 @@ pub(crate) fn entity_curve(found: &Found<'_>, path: &Path) -> Result<(Raw, f64),
                     z,
                 ));
             }
-            let z = planar(&mut sp.control_points.iter().map(|p| p.z))?;
+            let z = planar(&mut sp.control_points.iter().map(|p| p.z)).map_err(|(a, b)| {
+                err(format!(
+                    "z varies ({a} and {b}): a 3-D B-spline is not taken (a 3-D POLYLINE or \
+                     SPLINE fit points are, as a space curve)"
+                ))
+            })?;
             let degree = usize::try_from(sp.degree_of_curve)
                 .map_err(|_| err(format!("degree {} is not a degree", sp.degree_of_curve)))?;
             let ctrl: Vec<Point> = sp
@@ -349,6 +382,9 @@ pub enum DxfGeometry<'a> {
     /// A B-spline for a `SPLINE` with control points: degree, knots, control points and
     /// weights are replaced.
     Curve(&'a BSplineCurve),
+    /// Space points for a 3-D `POLYLINE` or `SPLINE` fit points read as a space curve: x, y
+    /// and z are replaced.
+    Space(&'a [Xyz]),
 }
 
 impl DxfDrawing {
@@ -410,18 +446,20 @@ impl DxfDrawing {
         // New (x, y) for `n` vertices of which the first `given` were read (a closed
         // entity may repeat its first vertex at the end).
         let points_for = |n: usize, pts: &[Point]| -> Result<Vec<Point>, IoError> {
-            match n.checked_sub(pts.len()) {
-                Some(0) => Ok(pts.to_vec()),
-                Some(1) if pts.len() > 1 => {
-                    let mut v = pts.to_vec();
-                    v.push(pts[0]);
-                    Ok(v)
-                }
-                _ => Err(fail(format!(
+            repeat_first(n, pts).ok_or_else(|| {
+                fail(format!(
                     "{} points for an entity of {n} vertices",
                     pts.len()
-                ))),
-            }
+                ))
+            })
+        };
+        let space_for = |n: usize, pts: &[Xyz]| -> Result<Vec<Xyz>, IoError> {
+            repeat_first(n, pts).ok_or_else(|| {
+                fail(format!(
+                    "{} points for an entity of {n} vertices",
+                    pts.len()
+                ))
+            })
         };
         match (&mut e.specific, geometry) {
             (EntityType::LwPolyline(lw), DxfGeometry::Points(pts)) => {
@@ -439,6 +477,23 @@ impl DxfDrawing {
                 let on_curve = pl.vertices_mut().filter(|v| v.flags & VERTEX_FRAME == 0);
                 for (v, p) in on_curve.zip(new) {
                     (v.location.x, v.location.y) = (p.x, p.y);
+                }
+            }
+            (EntityType::Polyline(pl), DxfGeometry::Space(pts)) => {
+                let n = pl
+                    .vertices()
+                    .filter(|v| v.flags & VERTEX_FRAME == 0)
+                    .count();
+                let new = space_for(n, pts)?;
+                let on_curve = pl.vertices_mut().filter(|v| v.flags & VERTEX_FRAME == 0);
+                for (v, p) in on_curve.zip(new) {
+                    v.location = dxf::Point::new(p[0], p[1], p[2]);
+                }
+            }
+            (EntityType::Spline(sp), DxfGeometry::Space(pts)) if sp.control_points.is_empty() => {
+                let new = space_for(sp.fit_points.len(), pts)?;
+                for (v, p) in sp.fit_points.iter_mut().zip(new) {
+                    *v = dxf::Point::new(p[0], p[1], p[2]);
                 }
             }
             (EntityType::Spline(sp), DxfGeometry::Points(pts)) if sp.control_points.is_empty() => {
@@ -497,11 +552,30 @@ impl DxfDrawing {
     }
 }
 
-/// A new R2000 drawing holding `entity` on the origin's layer.
-fn drawing_with(mut entity: Entity, origin: &Origin) -> Drawing {
+/// `pts` for an entity of `n` vertices: as they are, or with the first repeated at the end
+/// (a closed entity that repeats its first vertex); `None` for another count.
+fn repeat_first<T: Copy>(n: usize, pts: &[T]) -> Option<Vec<T>> {
+    match n.checked_sub(pts.len()) {
+        Some(0) => Some(pts.to_vec()),
+        Some(1) if pts.len() > 1 => {
+            let mut v = pts.to_vec();
+            v.push(pts[0]);
+            Some(v)
+        }
+        _ => None,
+    }
+}
+
+/// The layer an output goes on: the input's, else `0`.
+fn layer_of(origin: &Origin) -> String {
+    origin.layer.clone().unwrap_or_else(|| "0".to_string())
+}
+
+/// A new R2000 drawing with the origin's layer, holding `entity` on it.
+fn drawing_with(entity: Option<Entity>, origin: &Origin) -> Drawing {
     let mut drawing = Drawing::new();
     drawing.header.version = AcadVersion::R2000;
-    let layer = origin.layer.clone().unwrap_or_else(|| "0".to_string());
+    let layer = layer_of(origin);
     if !drawing.layers().any(|l| l.name == layer) {
         let l = dxf::tables::Layer {
             name: layer.clone(),
@@ -509,8 +583,10 @@ fn drawing_with(mut entity: Entity, origin: &Origin) -> Drawing {
         };
         drawing.add_layer(l);
     }
-    entity.common.layer = layer;
-    drawing.add_entity(entity);
+    if let Some(mut entity) = entity {
+        entity.common.layer = layer;
+        drawing.add_entity(entity);
+    }
     drawing
 }
 
@@ -543,7 +619,37 @@ pub(crate) fn format_points(
     lw.set_is_closed(closed);
     let mut entity = Entity::new(EntityType::LwPolyline(lw));
     entity.common.elevation = origin.z;
-    save(&drawing_with(entity, origin), path)
+    save(&drawing_with(Some(entity), origin), path)
+}
+
+/// Space points as a 3-D POLYLINE.
+pub(crate) fn format_space_points(
+    points: &[Xyz],
+    closed: bool,
+    origin: &Origin,
+    path: &Path,
+) -> Result<Vec<u8>, IoError> {
+    let mut drawing = drawing_with(None, origin);
+    let mut pl = Polyline {
+        flags: POLYLINE_3D,
+        ..Default::default()
+    };
+    for p in points {
+        // The vertices' handles come from the drawing they go into.
+        pl.add_vertex(
+            &mut drawing,
+            Vertex {
+                location: dxf::Point::new(p[0], p[1], p[2]),
+                flags: VERTEX_3D,
+                ..Default::default()
+            },
+        );
+    }
+    pl.set_is_closed(closed);
+    let mut entity = Entity::new(EntityType::Polyline(pl));
+    entity.common.layer = layer_of(origin);
+    drawing.add_entity(entity);
+    save(&drawing, path)
 }
 
 /// A B-spline as a SPLINE.
@@ -570,7 +676,7 @@ pub(crate) fn format_curve(
     sp.set_is_rational(curve.weights().is_some());
     sp.set_is_closed(closed);
     save(
-        &drawing_with(Entity::new(EntityType::Spline(sp)), origin),
+        &drawing_with(Some(Entity::new(EntityType::Spline(sp))), origin),
         path,
     )
 }
@@ -683,6 +789,31 @@ mod tests {
         out
     }
 
+    /// A SPLINE with control points whose z varies is a 3-D B-spline: refused in one line.
+    #[test]
+    fn a_3d_bspline_is_refused() {
+        let mut d = Drawing::new();
+        d.header.version = AcadVersion::R2000;
+        let sp = Spline {
+            degree_of_curve: 3,
+            knot_values: vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
+            control_points: (0..4)
+                .map(|i| dxf::Point::new(f64::from(i), 1.0, 0.5 * f64::from(i)))
+                .collect(),
+            ..Default::default()
+        };
+        d.add_entity(Entity::new(EntityType::Spline(sp)));
+        let mut bytes = Vec::new();
+        d.save(&mut bytes).unwrap();
+        let e = read(&bytes, &Pick::default()).unwrap_err();
+        assert!(e.starts_with("d.dxf: SPLINE "), "{e}");
+        assert!(
+            e.contains("z varies (0 and 0.5): a 3-D B-spline is not taken"),
+            "{e}"
+        );
+        assert_eq!(e.lines().count(), 1);
+    }
+
     #[test]
     fn picking_by_handle_or_layer_and_the_ambiguity_message() {
         let bytes = two_entities();
@@ -703,12 +834,13 @@ mod tests {
             e.starts_with("d.dxf: no curve entity on layer X (curve entities: "),
             "{e}"
         );
-        let e = read(&bytes, &Pick::default().with_layer(Some("C".into()))).unwrap_err();
-        assert!(
-            e.contains("z varies (0 and 1): 3-D curves are not supported yet"),
-            "{e}"
-        );
-        assert!(e.starts_with("d.dxf: SPLINE "), "{e}");
+        // SPLINE fit points whose z varies: a space curve.
+        let (raw, o) = read(&bytes, &Pick::default().with_layer(Some("C".into()))).unwrap();
+        assert_eq!(o.layer.as_deref(), Some("C"));
+        let Raw::Space { points, .. } = raw else {
+            panic!("not a space curve: {raw:?}")
+        };
+        assert_eq!(points[3], [3.0, 0.0, 3.0]);
     }
 
     #[test]

@@ -56,7 +56,7 @@ pub enum IoError {
         path: PathBuf,
     },
     /// A row (a text line, or one JSON point or tangent) does not have exactly two fields.
-    #[error("{}:{line}: expected 2 fields (x, y), found {found}", path.display())]
+    #[error("{}:{line}: expected {expected}, found {found}", path.display())]
     FieldCount {
         /// The file.
         path: PathBuf,
@@ -64,6 +64,8 @@ pub enum IoError {
         line: usize,
         /// How many fields the row has.
         found: usize,
+        /// What the row must hold (`2 fields (x, y)`, `3 fields (x, y, z)`, or either).
+        expected: &'static str,
     },
     /// A field is not a number.
     #[error("{}:{line}: field {field} '{text}' is not a number", path.display())]
@@ -213,6 +215,15 @@ pub enum IoError {
         path.display()
     )]
     CurveNotPoints {
+        /// The file.
+        path: PathBuf,
+    },
+    /// Planar points were asked for, and the file holds a space curve.
+    #[error(
+        "{}: the file holds a 3-D curve (x, y, z points), not a planar one",
+        path.display()
+    )]
+    SpaceNotPlanar {
         /// The file.
         path: PathBuf,
     },

@@ -13,14 +13,16 @@
 //! Read: entity 126 (rational B-spline curve: K, M, PROP1–4, knots, weights, control points,
 //! V(0), V(1), normal) as a B-spline (without weights when PROP3 says polynomial or all
 //! weights are equal), and entity 106 (copious data) forms 1, 2, 11, 12 and 63 (closed) as
-//! points. Only independent entities count (subordinate switch 00 or 02); entities with a
-//! transformation matrix are refused, as are curves whose z varies (3-D curves are not
-//! supported yet) and 126 entities that use part of their parameter range. Which one:
+//! points: planar when every z is the same, else a space curve (closed when its last point
+//! repeats its first). Only independent entities count (subordinate switch 00 or 02);
+//! entities with a transformation matrix are refused, as are 126 entities whose z varies (a
+//! 3-D B-spline) and 126 entities that use part of their parameter range. Which one:
 //! [`Pick::entity`] names the directory entry (its sequence number), [`Pick::layer`] the
 //! level; otherwise the only curve of the file.
 //!
 //! Write: a B-spline as entity 126, points as entity 106 form 11 (63 when closed), both at
-//! the origin's z, in millimetres. Reals are written as the shortest decimal that reads
+//! the origin's z, space points as entity 106 form 12 (x, y, z triples; a closed curve's
+//! first point repeated at the end), in millimetres. Reals are written as the shortest decimal that reads
 //! back bit for bit (`1.0D-1`), so a file batten writes reads back exactly.
 
 use std::fmt::Write as _;
@@ -406,12 +408,10 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Orig
         layer: Some(e.level.to_string()),
         name: Some(e.de.to_string()),
     };
-    let planar = |zs: &[f64]| -> Result<f64, IoError> {
+    // The constant z, or the first two values that differ.
+    let planar = |zs: &[f64]| -> Result<f64, (f64, f64)> {
         match zs.iter().find(|&&z| z != zs[0]) {
-            Some(&z) => Err(fail(format!(
-                "z varies ({} and {z}): 3-D curves are not supported yet",
-                zs[0]
-            ))),
+            Some(&z) => Err((zs[0], z)),
             None => Ok(zs.first().copied().unwrap_or(0.0)),
         }
     };
@@ -438,7 +438,27 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Orig
                 None => tr(3)?,
             });
         }
-        let z = planar(&z)?;
+        let z = match planar(&z) {
+            Ok(z) => z,
+            Err(_) => {
+                let mut points: Vec<[f64; 3]> =
+                    points.iter().zip(&z).map(|(p, z)| [p.x, p.y, *z]).collect();
+                // A copious-data curve that returns to its start is closed.
+                let closed = points.len() > 1 && points.last() == points.first();
+                if closed {
+                    points.pop();
+                }
+                let lines = vec![pline; points.len()];
+                return Ok((
+                    Raw::Space {
+                        points,
+                        lines,
+                        closed,
+                    },
+                    origin,
+                ));
+            }
+        };
         let closed = e.form == 63;
         if closed && points.len() > 1 && points.last() == points.first() {
             points.pop();
@@ -477,7 +497,12 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Orig
         ctrl.push(Point::new(tr(cb + 3 * i)?, tr(cb + 3 * i + 1)?));
         z.push(tr(cb + 3 * i + 2)?);
     }
-    let z = planar(&z)?;
+    let z = planar(&z).map_err(|(a, b)| {
+        fail(format!(
+            "z varies ({a} and {b}): a 3-D B-spline is not taken (3-D copious data, entity 106, \
+             is, as a space curve)"
+        ))
+    })?;
     let (v0, v1) = (tr(vb)?, tr(vb + 1)?);
     let weights = if polynomial || weights.iter().all(|&w| w == weights[0]) {
         None
@@ -659,6 +684,21 @@ pub(crate) fn format_points(points: &[Point], closed: bool, origin: &Origin) -> 
     file(106, form, &params, max_coordinate(points, origin.z), origin)
 }
 
+/// Space points as entity 106 form 12 (x, y, z triples; a closed curve's first point
+/// repeated at the end, which is how it reads back as closed).
+pub(crate) fn format_space_points(points: &[[f64; 3]], closed: bool, origin: &Origin) -> String {
+    let mut all: Vec<[f64; 3]> = points.to_vec();
+    if closed && let Some(&first) = points.first() {
+        all.push(first);
+    }
+    let mut params = vec!["106".to_string(), "2".into(), all.len().to_string()];
+    for p in &all {
+        params.extend(p.iter().map(|&c| real_str(c)));
+    }
+    let max = all.iter().flatten().fold(1.0_f64, |m, c| m.max(c.abs()));
+    file(106, 12, &params, max, origin)
+}
+
 /// A B-spline as entity 126 (planar, normal +z).
 pub(crate) fn format_curve(curve: &BSplineCurve, closed: bool, origin: &Origin) -> String {
     let ctrl = curve.control_points();
@@ -761,7 +801,7 @@ mod tests {
     fn raw_curve(r: Raw) -> BSplineCurve {
         match r {
             Raw::Curve(c) => c,
-            Raw::Points { .. } => panic!("points"),
+            _ => panic!("not a curve"),
         }
     }
 
@@ -809,7 +849,7 @@ S      1G      2D      4P      3                                        T      1
 ";
 
     #[test]
-    fn other_writers_style_picking_and_3d_refusal() {
+    fn other_writers_style_picking_and_3d_copious_data() {
         let e = read(TWO, &Pick::default()).unwrap_err();
         assert_eq!(
             e,
@@ -822,11 +862,14 @@ S      1G      2D      4P      3                                        T      1
         assert_eq!(points[3], Point::new(2.0, 1.5));
         assert_eq!(lines, vec![8; 4]);
         assert_eq!(o.z, 0.0);
-        let e = read(TWO, &Pick::default().with_layer(Some("5".into()))).unwrap_err();
-        assert_eq!(
-            e,
-            "c.igs:9: entity 106 form 12 at DE 3 (level 5): z varies (0 and 1): 3-D curves are not supported yet"
-        );
+        // Its z varies: a space curve.
+        let (raw, _) = read(TWO, &Pick::default().with_layer(Some("5".into()))).unwrap();
+        let Raw::Space { points, closed, .. } = raw else {
+            panic!("not a space curve")
+        };
+        assert!(!closed);
+        assert_eq!(points[1], [1.0, 0.0, 0.0]);
+        assert_eq!(points[3], [2.0, 1.5, 2.0]);
         let e = read(TWO, &Pick::default().with_entity(Some("7".into()))).unwrap_err();
         assert!(
             e.starts_with(

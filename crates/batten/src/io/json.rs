@@ -1,6 +1,7 @@
 //! Point lists and B-spline curves as JSON (`.json`).
 //!
-//! A point list is `{"points": [[x, y], ...], "closed": false, "tangents": [[dx, dy], ...]}`;
+//! A point list is `{"points": [[x, y], ...], "closed": false, "tangents": [[dx, dy], ...]}`
+//! (a space curve: `[x, y, z]` points, every point alike, no tangents);
 //! `closed` (default `false`) and `tangents` (one per point, for Hermite methods) are optional
 //! and any other key is an error (a misspelt `"close": true` must not be ignored). A B-spline
 //! is the object [`BSplineCurve`] serialises to: `{"degree": p, "knots": [...],
@@ -15,7 +16,8 @@ use std::path::Path;
 use serde::Deserialize;
 
 use super::IoError;
-use crate::geom::{Point, Vec2};
+use super::text::Coords;
+use crate::geom::{Point, Vec2, Xyz};
 use crate::spline::{BSplineCurve, KnotVector};
 
 /// Keys that mark a B-spline object.
@@ -47,7 +49,7 @@ struct CurveJson {
 
 /// A parsed JSON point list, not yet validated as a [`crate::PointSeq`].
 pub(crate) struct ParsedJson {
-    pub points: Vec<Point>,
+    pub coords: Coords,
     pub lines: Vec<usize>,
     pub closed: bool,
     pub tangents: Option<Vec<Vec2>>,
@@ -127,10 +129,23 @@ pub(crate) fn parse_points(bytes: &[u8], path: &Path) -> Result<ParsedJson, IoEr
     }
     let raw: PointsJson = serde_json::from_str(text).map_err(|e| json_error(path, &e))?;
     let lines = lines_or_first(element_lines(text, "points"), raw.points.len());
-    let points = pairs(raw.points, &lines, path)?
-        .into_iter()
-        .map(|(x, y)| Point::new(x, y))
-        .collect();
+    let space = raw.points.first().is_some_and(|p| p.len() == 3);
+    let coords = if space {
+        Coords::Space(triples(raw.points, &lines, path)?)
+    } else {
+        Coords::Planar(
+            pairs(raw.points, &lines, path)?
+                .into_iter()
+                .map(|(x, y)| Point::new(x, y))
+                .collect(),
+        )
+    };
+    if space && raw.tangents.is_some() {
+        return Err(IoError::JsonContent {
+            path: path.to_path_buf(),
+            message: "tangents are taken with planar points only, not with [x, y, z] points".into(),
+        });
+    }
     let (tangents, tangent_lines) = match raw.tangents {
         Some(t) => {
             let tl = lines_or_first(element_lines(text, "tangents"), t.len());
@@ -143,7 +158,7 @@ pub(crate) fn parse_points(bytes: &[u8], path: &Path) -> Result<ParsedJson, IoEr
         None => (None, Vec::new()),
     };
     Ok(ParsedJson {
-        points,
+        coords,
         lines,
         closed: raw.closed,
         tangents,
@@ -161,6 +176,23 @@ fn pairs(raw: Vec<Vec<f64>>, lines: &[usize], path: &Path) -> Result<Vec<(f64, f
                 path: path.to_path_buf(),
                 line,
                 found: v.len(),
+                expected: "2 fields (x, y)",
+            }),
+        })
+        .collect()
+}
+
+/// Check that every element has three coordinates (a space curve: the first point had three).
+fn triples(raw: Vec<Vec<f64>>, lines: &[usize], path: &Path) -> Result<Vec<Xyz>, IoError> {
+    raw.into_iter()
+        .zip(lines)
+        .map(|(v, &line)| match v[..] {
+            [x, y, z] => Ok([x, y, z]),
+            _ => Err(IoError::FieldCount {
+                path: path.to_path_buf(),
+                line,
+                found: v.len(),
+                expected: "3 fields (x, y, z), as the first point",
             }),
         })
         .collect()
@@ -207,6 +239,27 @@ pub(crate) fn parse_curve(bytes: &[u8], path: &Path) -> Result<BSplineCurve, IoE
 /// One number as serde_json writes it: shortest round-trip digits (`1.0`, `1e300`, `-0.0`).
 fn number(x: f64) -> String {
     serde_json::Value::from(x).to_string()
+}
+
+/// The JSON text of a space curve's points, one point per line.
+pub(crate) fn format_space(points: &[Xyz], closed: bool) -> String {
+    let mut out = String::with_capacity(32 + points.len() * 64);
+    out.push_str("{\n  \"points\": [\n");
+    for (i, p) in points.iter().enumerate() {
+        if i > 0 {
+            out.push_str(",\n");
+        }
+        // Writing to a String cannot fail.
+        let _ = write!(
+            out,
+            "    [{}, {}, {}]",
+            number(p[0]),
+            number(p[1]),
+            number(p[2])
+        );
+    }
+    let _ = write!(out, "\n  ],\n  \"closed\": {closed}\n}}\n");
+    out
 }
 
 /// The JSON text of a point list, one point per line (so that read-back errors name it).
@@ -361,6 +414,17 @@ impl Scanner<'_> {
 }
 
 #[cfg(test)]
+impl ParsedJson {
+    /// The planar points (none for a space curve).
+    fn points(&self) -> &[Point] {
+        match &self.coords {
+            Coords::Planar(p) => p,
+            Coords::Space(_) => &[],
+        }
+    }
+}
+
+#[cfg(test)]
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
@@ -393,7 +457,7 @@ mod tests {
     fn reads_points_closed_tangents() {
         let t = "{\"points\": [[0, 0], [1, 0.5], [2, 1e-3]],\n\"closed\": true,\n\"tangents\": [[1, 0], [1, 0], [1, 0]]}";
         let p = parse_points(t.as_bytes(), path()).unwrap();
-        assert_eq!(p.points[1], Point::new(1.0, 0.5));
+        assert_eq!(p.points()[1], Point::new(1.0, 0.5));
         assert!(p.closed);
         assert_eq!(p.tangents.unwrap().len(), 3);
         assert_eq!(p.lines, vec![1, 1, 1]);
@@ -491,7 +555,7 @@ mod tests {
         assert!(p.closed);
         assert_eq!(p.lines, vec![3, 4, 5, 6]);
         assert_eq!(p.tangent_lines, vec![10, 11, 12, 13]);
-        for (a, b) in pts.iter().zip(&p.points) {
+        for (a, b) in pts.iter().zip(p.points()) {
             assert_eq!(a.x.to_bits(), b.x.to_bits(), "{a:?} {b:?}");
             assert_eq!(a.y.to_bits(), b.y.to_bits(), "{a:?} {b:?}");
         }

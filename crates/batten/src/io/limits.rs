@@ -24,18 +24,25 @@ pub(crate) fn check_magnitudes(
     points: &[Point],
     lines: &[usize],
 ) -> Result<(), IoError> {
-    let too_large = |v: f64| v.abs() > MAX_COORDINATE;
-    match points.iter().position(|p| too_large(p.x) || too_large(p.y)) {
-        None => Ok(()),
-        Some(i) => {
-            let p = points[i];
-            Err(IoError::TooLarge {
+    check_coordinates(path, points.iter().map(|p| [p.x, p.y]), lines)
+}
+
+/// [`check_magnitudes`] for points of any dimension.
+pub(crate) fn check_coordinates<const D: usize>(
+    path: &Path,
+    points: impl Iterator<Item = [f64; D]>,
+    lines: &[usize],
+) -> Result<(), IoError> {
+    for (i, p) in points.enumerate() {
+        if let Some(&value) = p.iter().find(|v| v.abs() > MAX_COORDINATE) {
+            return Err(IoError::TooLarge {
                 path: path.to_path_buf(),
                 line: lines.get(i).copied().unwrap_or(1),
-                value: if too_large(p.x) { p.x } else { p.y },
-            })
+                value,
+            });
         }
     }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -88,8 +88,9 @@ pub use surface::{format_surface, parse_surface, read_surface_json, write_surfac
 pub use text::format_f64;
 
 use crate::error::Error;
-use crate::geom::{Point, PointSeq, Vec2};
+use crate::geom::{Point, PointSeq, SpaceSeq, Vec2, Xyz};
 use crate::spline::BSplineCurve;
+use text::Coords;
 
 /// A file format, chosen by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -179,6 +180,15 @@ pub struct PointData {
     pub lines: Vec<usize>,
 }
 
+/// A space curve's points read from a file (text or JSON with `x, y, z`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpaceData {
+    /// The validated points, closed if the file or the options say so.
+    pub seq: SpaceSeq,
+    /// The 1-based line each point starts on.
+    pub lines: Vec<usize>,
+}
+
 /// Read a point list (format by extension) and validate it.
 ///
 /// # Errors
@@ -205,25 +215,53 @@ pub fn parse_points(
     path: &Path,
     options: &ReadOptions,
 ) -> Result<PointData, IoError> {
-    let (points, lines, closed, tangents, tangent_lines) = match format {
-        Format::Text => {
-            let t = text::parse(bytes, path)?;
-            (t.points, t.lines, false, None, Vec::new())
-        }
-        Format::Json => {
-            let j = json::parse_points(bytes, path)?;
-            (j.points, j.lines, j.closed, j.tangents, j.tangent_lines)
-        }
+    let source = match format {
+        Format::Text | Format::Json => parse_text_or_json(bytes, format, path, options)?,
         Format::Dxf | Format::Iges | Format::Svg => {
-            return match parse_input(bytes, format, path, options, &Pick::default())?.source {
-                Source::Points(d) => Ok(d),
-                Source::Curve(_) => Err(IoError::CurveNotPoints {
-                    path: path.to_path_buf(),
-                }),
-            };
+            parse_input(bytes, format, path, options, &Pick::default())?.source
         }
     };
+    match source {
+        Source::Points(d) => Ok(d),
+        Source::Curve(_) => Err(IoError::CurveNotPoints {
+            path: path.to_path_buf(),
+        }),
+        Source::Space(_) => Err(IoError::SpaceNotPlanar {
+            path: path.to_path_buf(),
+        }),
+    }
+}
+
+/// A text or JSON file: planar points (with their tangents), space points, or (JSON) a
+/// B-spline.
+fn parse_text_or_json(
+    bytes: &[u8],
+    format: Format,
+    path: &Path,
+    options: &ReadOptions,
+) -> Result<Source, IoError> {
+    let (coords, lines, closed, tangents, tangent_lines) = if format == Format::Json {
+        match json::parse_points(bytes, path) {
+            Ok(j) => (j.coords, j.lines, j.closed, j.tangents, j.tangent_lines),
+            Err(IoError::CurveNotPoints { .. }) => {
+                return Ok(Source::Curve(json::parse_curve(bytes, path)?));
+            }
+            Err(e) => return Err(e),
+        }
+    } else {
+        let t = text::parse(bytes, path)?;
+        (t.coords, t.lines, false, None, Vec::new())
+    };
     let closed = closed || options.closed;
+    let points = match coords {
+        Coords::Planar(points) => points,
+        Coords::Space(points) => {
+            return Ok(Source::Space(SpaceData {
+                seq: validate_space(path, points, &lines, closed)?,
+                lines,
+            }));
+        }
+    };
     let seq = validate(path, points, &lines, closed)?;
     if let Some(t) = &tangents {
         if t.len() != seq.len() {
@@ -240,11 +278,11 @@ pub fn parse_points(
             });
         }
     }
-    Ok(PointData {
+    Ok(Source::Points(PointData {
         seq,
         tangents,
         lines,
-    })
+    }))
 }
 
 /// Wrap the points in a [`PointSeq`], turning its index-based errors into line-based ones.
@@ -259,55 +297,86 @@ fn validate(
             path: path.to_path_buf(),
         });
     }
-    let line = |i: usize| lines.get(i).copied().unwrap_or(1);
     limits::check_magnitudes(path, &points, lines)?;
     // What tells a repeated neighbour from a closed curve's repeated first point, noted before
     // the points move into the sequence (rather than validating a copy: 16 MB at 10⁶ points).
     let n = points.len();
     let last_repeats_previous = n >= 2 && points[n - 1] == points[n - 2];
-    match PointSeq::new(points, closed) {
-        Ok(seq) => Ok(seq),
-        Err(Error::TooFewPoints { needed, got }) => Err(IoError::TooFewPoints {
+    PointSeq::new(points, closed)
+        .map_err(|e| seq_error(path, lines, closed, n, last_repeats_previous, e))
+}
+
+/// [`validate`] for a space curve: the same rules, the same messages.
+fn validate_space(
+    path: &Path,
+    points: Vec<Xyz>,
+    lines: &[usize],
+    closed: bool,
+) -> Result<SpaceSeq, IoError> {
+    if points.is_empty() {
+        return Err(IoError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    limits::check_coordinates(path, points.iter().copied(), lines)?;
+    let n = points.len();
+    let last_repeats_previous = n >= 2 && points[n - 1] == points[n - 2];
+    SpaceSeq::new(points, closed)
+        .map_err(|e| seq_error(path, lines, closed, n, last_repeats_previous, e))
+}
+
+/// A point sequence's index-based error as a line-based one.
+fn seq_error(
+    path: &Path,
+    lines: &[usize],
+    closed: bool,
+    n: usize,
+    last_repeats_previous: bool,
+    error: Error,
+) -> IoError {
+    let line = |i: usize| lines.get(i).copied().unwrap_or(1);
+    match error {
+        Error::TooFewPoints { needed, got } => IoError::TooFewPoints {
             path: path.to_path_buf(),
             got,
             needed,
-        }),
-        Err(Error::NonFinite { index }) => Err(IoError::NonFinite {
+        },
+        Error::NonFinite { index } => IoError::NonFinite {
             path: path.to_path_buf(),
             line: line(index),
-        }),
-        Err(Error::DuplicatePoint { index })
+        },
+        Error::DuplicatePoint { index }
             if index > 0 && (index + 1 < n || !closed || last_repeats_previous) =>
         {
-            Err(IoError::DuplicatePoint {
+            IoError::DuplicatePoint {
                 path: path.to_path_buf(),
                 line: line(index),
                 previous: line(index - 1),
-            })
+            }
         }
-        Err(Error::DuplicatePoint { index }) => Err(IoError::RepeatsFirst {
+        Error::DuplicatePoint { index } => IoError::RepeatsFirst {
             path: path.to_path_buf(),
             line: line(index),
             first: line(0),
-        }),
-        Err(Error::NearDuplicate {
+        },
+        Error::NearDuplicate {
             index,
             previous,
             relative,
-        }) => {
+        } => {
             // The closing chord of a closed curve comes as (first, last): name the later line.
             let (a, b) = (line(index), line(previous));
-            Err(IoError::NearDuplicate {
+            IoError::NearDuplicate {
                 path: path.to_path_buf(),
                 line: a.max(b),
                 other: a.min(b),
                 relative,
-            })
+            }
         }
-        Err(source) => Err(IoError::Invalid {
+        source => IoError::Invalid {
             path: path.to_path_buf(),
             source,
-        }),
+        },
     }
 }
 
@@ -441,6 +510,8 @@ pub enum Source {
     Points(PointData),
     /// A B-spline curve.
     Curve(BSplineCurve),
+    /// A validated space curve (`x, y, z` points).
+    Space(SpaceData),
 }
 
 /// A curve read from a file and where it sat.
@@ -463,6 +534,12 @@ pub(crate) enum Raw {
     },
     /// A B-spline.
     Curve(BSplineCurve),
+    /// Space points (a 3-D DXF POLYLINE, or SPLINE fit points, whose z varies).
+    Space {
+        points: Vec<Xyz>,
+        lines: Vec<usize>,
+        closed: bool,
+    },
 }
 
 /// Parse any input format held in memory (a file's bytes, or standard input); `path` names
@@ -480,23 +557,9 @@ pub fn parse_input(
     pick: &Pick,
 ) -> Result<Input, IoError> {
     let (raw, origin) = match format {
-        Format::Text => {
-            let d = parse_points(bytes, format, path, options)?;
+        Format::Text | Format::Json => {
             return Ok(Input {
-                source: Source::Points(d),
-                origin: Origin::default(),
-            });
-        }
-        Format::Json => {
-            let source = match parse_points(bytes, format, path, options) {
-                Ok(d) => Source::Points(d),
-                Err(IoError::CurveNotPoints { .. }) => {
-                    Source::Curve(json::parse_curve(bytes, path)?)
-                }
-                Err(e) => return Err(e),
-            };
-            return Ok(Input {
-                source,
+                source: parse_text_or_json(bytes, format, path, options)?,
                 origin: Origin::default(),
             });
         }
@@ -523,6 +586,14 @@ fn validated(raw: Raw, path: &Path, options: &ReadOptions) -> Result<Source, IoE
             lines,
         }),
         Raw::Curve(c) => Source::Curve(c),
+        Raw::Space {
+            points,
+            lines,
+            closed,
+        } => Source::Space(SpaceData {
+            seq: validate_space(path, points, &lines, closed || options.closed)?,
+            lines,
+        }),
     })
 }
 
@@ -583,6 +654,39 @@ pub fn format_points(
             svg::format_curve(&curve, closed, origin, path)?.into_bytes()
         }
     })
+}
+
+/// The bytes of a space curve's points in `format`: text (`x,y,z`), JSON, a DXF 3-D
+/// `POLYLINE` on the origin's layer, or IGES copious data (entity 106 form 12). SVG holds
+/// planar curves only.
+///
+/// # Errors
+/// [`IoError::NonFiniteOutput`]; [`IoError::Format`] for a format that takes planar curves
+/// only.
+pub fn format_space_points(
+    format: Format,
+    path: &Path,
+    points: &[Xyz],
+    closed: bool,
+    origin: &Origin,
+) -> Result<Vec<u8>, IoError> {
+    if let Some(index) = points.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+        return Err(IoError::NonFiniteOutput {
+            path: path.to_path_buf(),
+            index,
+        });
+    }
+    match format {
+        Format::Text => Ok(text::format_space(points).into_bytes()),
+        Format::Json => Ok(json::format_space(points, closed).into_bytes()),
+        Format::Dxf => dxf::format_space_points(points, closed, origin, path),
+        Format::Iges => Ok(iges::format_space_points(points, closed, origin).into_bytes()),
+        Format::Svg => Err(IoError::Format {
+            path: path.to_path_buf(),
+            at: Location::File,
+            message: "a 3-D curve is written as .csv, .txt, .json, .dxf or .igs".into(),
+        }),
+    }
 }
 
 /// The C² cubic through the points as a B-spline (the analysis curve of `crate::analysis`).

@@ -1,4 +1,5 @@
-//! Point lists as text: one `x,y` per line (`.csv`, `.txt`).
+//! Point lists as text: one `x,y` (a planar curve) or `x,y,z` (a space curve) per line
+//! (`.csv`, `.txt`).
 //!
 //! # Reading
 //!
@@ -13,35 +14,158 @@
 //!    removed (spreadsheets quote numbers). Empty fields count (`1,2,` has three fields).
 //! 3. The first non-empty line is a header, and skipped, when *none* of its fields is a number
 //!    (`x,y`, `X Y`). Any later non-numeric field is an error.
-//! 4. Every other line has exactly two fields, each a number as Rust's `f64::from_str` reads
-//!    it (`1`, `-2.5`, `1e-300`, `.5`). `NaN`, `inf` and numbers too large for an `f64` are
-//!    errors, as are decimal commas (`1,5;2,5` is a row of two non-numbers).
+//! 4. Every other line has two fields (a planar curve) or three (a space curve), each a number
+//!    as Rust's `f64::from_str` reads it (`1`, `-2.5`, `1e-300`, `.5`). A header of three
+//!    fields (`x,y,z`) makes the file a space curve; otherwise the first data row decides, and
+//!    every row must have as many fields as it. `NaN`, `inf` and numbers too large for an
+//!    `f64` are errors, as are decimal commas (`1,5;2,5` is a row of two non-numbers).
 //!
 //! Line numbers are physical lines, 1-based; `\r\n` endings are accepted, and a UTF-8 byte
 //! order mark at the start is ignored.
 //!
 //! # Writing
 //!
-//! A header `x,y`, then one `x,y` row per point, with numbers in the shortest form that reads
+//! A header `x,y` (`x,y,z`), then one row per point, with numbers in the shortest form that reads
 //! back to the same `f64` bit for bit (see [`format_f64`]).
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use super::IoError;
-use crate::geom::Point;
+use crate::geom::{Point, Xyz};
 
 /// Longest field text echoed in an error message, in characters.
 const MAX_ECHO_CHARS: usize = 40;
 
+/// The points of a file: planar or in space.
+#[derive(Debug, PartialEq)]
+pub(crate) enum Coords {
+    /// `x,y` rows.
+    Planar(Vec<Point>),
+    /// `x,y,z` rows.
+    Space(Vec<Xyz>),
+}
+
 /// Points and the 1-based line each came from.
 pub(crate) struct ParsedText {
-    pub points: Vec<Point>,
+    pub coords: Coords,
     pub lines: Vec<usize>,
 }
 
+/// What a row must hold, as a message says it.
+fn expected_fields(dimension: Option<usize>) -> &'static str {
+    match dimension {
+        Some(2) => "2 fields (x, y)",
+        Some(3) => "3 fields (x, y, z)",
+        _ => "2 fields (x, y) or 3 (x, y, z)",
+    }
+}
+
+/// Inputs at least this large are read in parallel (see [`parse_parallel`]).
+const PARALLEL_MIN_BYTES: usize = 4 << 20;
+/// The part read first, alone, in [`parse_parallel`] (then cut at the next line end).
+const PREFIX_BYTES: usize = 64 << 10;
+/// The size of the pieces [`parse_parallel`] reads in parallel (cut at line ends).
+const PIECE_BYTES: usize = 1 << 20;
+
 /// Parse the text format. `path` is only used in error messages.
 pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<ParsedText, IoError> {
+    if bytes.len() >= PARALLEL_MIN_BYTES
+        && let Some(parsed) = parse_parallel(bytes)
+    {
+        return Ok(parsed);
+    }
+    parse_sequential(bytes, path)
+}
+
+/// [`parse_sequential`]'s result for a large planar file without errors, read in parallel:
+/// the first [`PREFIX_BYTES`] (to the next line end) by [`parse_sequential`], which settles
+/// the header and that the rows are `x,y`, then the rest in pieces of [`PIECE_BYTES`] cut at
+/// line ends, each by the same per-line rules, joined in order with their line numbers
+/// offset. `None` for anything else — a space curve, no data row in the prefix, any error —
+/// and the caller reads the file again sequentially, which gives the same points or the
+/// same first error.
+fn parse_parallel(bytes: &[u8]) -> Option<ParsedText> {
+    use rayon::prelude::*;
+
+    let text = std::str::from_utf8(bytes).ok()?;
+    // The end of the line that `from` is in (`from` ≤ the length).
+    let cut = |from: usize| -> usize {
+        match text.as_bytes()[from..].iter().position(|&b| b == b'\n') {
+            Some(k) => from + k + 1,
+            None => text.len(),
+        }
+    };
+    let split = cut(PREFIX_BYTES.min(text.len()));
+    let prefix = parse_sequential(&bytes[..split], Path::new("")).ok()?;
+    let Coords::Planar(mut points) = prefix.coords else {
+        return None;
+    };
+    if points.is_empty() {
+        return None;
+    }
+    let prefix_lines = text[..split].lines().count();
+    let mut pieces = Vec::new();
+    let mut start = split;
+    while start < text.len() {
+        let end = cut((start + PIECE_BYTES).min(text.len()));
+        pieces.push(&text[start..end]);
+        start = end;
+    }
+    let parsed: Vec<(Vec<Point>, Vec<usize>, usize)> = pieces
+        .par_iter()
+        .map(|piece| planar_rows(piece))
+        .collect::<Option<_>>()?;
+    let total: usize = parsed.iter().map(|p| p.0.len()).sum();
+    points.reserve_exact(total);
+    let mut lines = prefix.lines;
+    lines.reserve_exact(total);
+    let mut offset = prefix_lines;
+    for (p, l, count) in parsed {
+        points.extend_from_slice(&p);
+        lines.extend(l.iter().map(|k| k + offset));
+        offset += count;
+    }
+    Some(ParsedText {
+        coords: Coords::Planar(points),
+        lines,
+    })
+}
+
+/// The `x,y` rows of a piece of a file past its first data row, by [`parse_sequential`]'s
+/// rules, with their 1-based line numbers in the piece and the piece's number of lines;
+/// `None` at the first line that [`parse_sequential`] would refuse.
+fn planar_rows(piece: &str) -> Option<(Vec<Point>, Vec<usize>, usize)> {
+    let mut points = Vec::with_capacity(piece.len() / 24);
+    let mut lines = Vec::with_capacity(piece.len() / 24);
+    let mut count = 0;
+    for (i, raw) in piece.lines().enumerate() {
+        count = i + 1;
+        let content = match raw.find('#') {
+            Some(k) => &raw[..k],
+            None => raw,
+        }
+        .trim();
+        if content.is_empty() {
+            continue;
+        }
+        let mut fields = [""; 3];
+        if first_fields(content, &mut fields) != 2 {
+            return None;
+        }
+        let x = fields[0].parse::<f64>().ok()?;
+        let y = fields[1].parse::<f64>().ok()?;
+        if !(x.is_finite() && y.is_finite()) {
+            return None;
+        }
+        points.push(Point::new(x, y));
+        lines.push(i + 1);
+    }
+    Some((points, lines, count))
+}
+
+/// The text format read line by line (see the module documentation).
+fn parse_sequential(bytes: &[u8], path: &Path) -> Result<ParsedText, IoError> {
     let text = std::str::from_utf8(bytes).map_err(|e| IoError::NotUtf8 {
         path: path.to_path_buf(),
         line: 1 + bytes[..e.valid_up_to()]
@@ -53,9 +177,12 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<ParsedText, IoError> {
 
     // One point per line at most: reserve once rather than grow 20 times (10⁶ points).
     let capacity = 1 + bytes.iter().filter(|&&b| b == b'\n').count();
-    let mut points = Vec::with_capacity(capacity);
+    let mut planar: Vec<Point> = Vec::new();
+    let mut space: Vec<Xyz> = Vec::new();
     let mut lines = Vec::with_capacity(capacity);
     let mut seen_content = false;
+    // Set by a three-field header or by the first data row.
+    let mut dimension: Option<usize> = None;
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
         let content = match raw.find('#') {
@@ -68,24 +195,38 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<ParsedText, IoError> {
         }
         if !seen_content {
             seen_content = true;
-            if split_fields(content)
-                .iter()
-                .all(|f| f.parse::<f64>().is_err())
-            {
+            let header = split_fields(content);
+            if header.iter().all(|f| f.parse::<f64>().is_err()) {
+                if header.len() == 3 {
+                    dimension = Some(3);
+                }
                 continue; // the header
             }
         }
-        let mut fields = [""; 2];
-        let found = first_two_fields(content, &mut fields);
-        if found != 2 {
-            return Err(IoError::FieldCount {
-                path: path.to_path_buf(),
-                line,
-                found,
-            });
-        }
-        let mut xy = [0.0; 2];
-        for (k, (field, slot)) in fields.iter().zip(&mut xy).enumerate() {
+        let mut fields = [""; 3];
+        let found = first_fields(content, &mut fields);
+        let d = match dimension {
+            Some(d) if d == found => d,
+            None if found == 2 || found == 3 => {
+                dimension = Some(found);
+                if found == 2 {
+                    planar.reserve(capacity);
+                } else {
+                    space.reserve(capacity);
+                }
+                found
+            }
+            _ => {
+                return Err(IoError::FieldCount {
+                    path: path.to_path_buf(),
+                    line,
+                    found,
+                    expected: expected_fields(dimension),
+                });
+            }
+        };
+        let mut xyz = [0.0; 3];
+        for (k, (field, slot)) in fields[..d].iter().zip(&mut xyz).enumerate() {
             let v = field.parse::<f64>().map_err(|_| IoError::NotANumber {
                 path: path.to_path_buf(),
                 line,
@@ -100,10 +241,19 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<ParsedText, IoError> {
             }
             *slot = v;
         }
-        points.push(Point::new(xy[0], xy[1]));
+        if d == 2 {
+            planar.push(Point::new(xyz[0], xyz[1]));
+        } else {
+            space.push(xyz);
+        }
         lines.push(line);
     }
-    Ok(ParsedText { points, lines })
+    let coords = if dimension == Some(3) {
+        Coords::Space(space)
+    } else {
+        Coords::Planar(planar)
+    };
+    Ok(ParsedText { coords, lines })
 }
 
 /// Split a trimmed, comment-free, non-empty line into trimmed, unquoted fields.
@@ -119,9 +269,9 @@ fn split_fields(content: &str) -> Vec<&str> {
 }
 
 /// The fields of `content` as [`split_fields`] splits them, without collecting them: the
-/// first two go to `out`, and the number of fields is returned (the reader's inner loop,
+/// first three go to `out`, and the number of fields is returned (the reader's inner loop,
 /// 10⁶ lines and more).
-fn first_two_fields<'a>(content: &'a str, out: &mut [&'a str; 2]) -> usize {
+fn first_fields<'a>(content: &'a str, out: &mut [&'a str; 3]) -> usize {
     let mut n = 0;
     let mut put = |f: &'a str| {
         if let Some(slot) = out.get_mut(n) {
@@ -189,6 +339,21 @@ pub(crate) fn push_f64(out: &mut String, x: f64) {
     };
 }
 
+/// The text format of space points: header `x,y,z`, one row per point.
+pub(crate) fn format_space(points: &[Xyz]) -> String {
+    let mut out = String::with_capacity(16 + points.len() * 60);
+    out.push_str("x,y,z\n");
+    for p in points {
+        push_f64(&mut out, p[0]);
+        out.push(',');
+        push_f64(&mut out, p[1]);
+        out.push(',');
+        push_f64(&mut out, p[2]);
+        out.push('\n');
+    }
+    out
+}
+
 /// The text format of `points`: header `x,y`, one row per point.
 pub(crate) fn format(points: &[Point]) -> String {
     let mut out = String::with_capacity(16 + points.len() * 40);
@@ -200,6 +365,17 @@ pub(crate) fn format(points: &[Point]) -> String {
         out.push('\n');
     }
     out
+}
+
+#[cfg(test)]
+impl ParsedText {
+    /// The planar points (none for a space curve).
+    fn points(&self) -> &[Point] {
+        match &self.coords {
+            Coords::Planar(p) => p,
+            Coords::Space(_) => &[],
+        }
+    }
 }
 
 #[cfg(test)]
@@ -219,13 +395,49 @@ mod tests {
     }
 
     #[test]
+    fn parallel_reading_matches_sequential() {
+        // Past PARALLEL_MIN_BYTES, with every separator, comments, blank lines, CRLF, quotes
+        // and a header, so that the pieces cut through all of them.
+        let mut s = String::from("\u{feff}# made up\nx,y\n");
+        let mut i = 0_u64;
+        while s.len() < PARALLEL_MIN_BYTES + 3 * PIECE_BYTES / 2 {
+            let (x, y) = (i as f64 * 0.001, (i as f64 * 0.37).sin());
+            let _ = match i % 7 {
+                0 => writeln!(s, "{x},{y}"),
+                1 => writeln!(s, "{x};{y} # note"),
+                2 => writeln!(s, "  {x}\t{y}\r"),
+                3 => writeln!(s, "\"{x}\",\"{y}\""),
+                4 => writeln!(s, "{x:e} {y:e}\n"),
+                5 => writeln!(s, "# only a comment\n{x} , {y}"),
+                _ => writeln!(s, "{x},{y}"),
+            };
+            i += 1;
+        }
+        let bytes = s.as_bytes();
+        let par = parse_parallel(bytes).unwrap();
+        let seq = parse_sequential(bytes, Path::new("data.csv")).unwrap();
+        assert!(par.points().len() > 100_000);
+        assert_eq!(par.points(), seq.points());
+        assert_eq!(par.lines, seq.lines);
+        // An error anywhere: the parallel reader declines, and the error is the sequential
+        // reader's.
+        let bad = format!("{s}1,2,3\n");
+        assert!(parse_parallel(bad.as_bytes()).is_none());
+        let lines = bad.lines().count();
+        assert_eq!(
+            msg(&bad),
+            format!("data.csv:{lines}: expected 2 fields (x, y), found 3")
+        );
+    }
+
+    #[test]
     fn separators_comments_header() {
         let p = parse_str(
             "# a comment\n\nx,y\n0,1\n1;2 # trailing\n  2\t3\n3   4\r\n\"4\",\"5\"\n 5 , 6 \n",
         )
         .unwrap();
         assert_eq!(
-            p.points,
+            p.points(),
             vec![
                 Point::new(0.0, 1.0),
                 Point::new(1.0, 2.0),
@@ -241,7 +453,7 @@ mod tests {
     #[test]
     fn header_only_on_first_content_line() {
         let p = parse_str("# c\nX Y\n1 2\n").unwrap();
-        assert_eq!(p.points, vec![Point::new(1.0, 2.0)]);
+        assert_eq!(p.points(), vec![Point::new(1.0, 2.0)]);
         assert_eq!(
             msg("x,y\n1,2\nx,y\n"),
             "data.csv:3: field 1 'x' is not a number"
@@ -253,13 +465,18 @@ mod tests {
     #[test]
     fn byte_order_mark_is_ignored() {
         let p = parse_str("\u{feff}x,y\n1,2\n").unwrap();
-        assert_eq!(p.points, vec![Point::new(1.0, 2.0)]);
+        assert_eq!(p.points(), vec![Point::new(1.0, 2.0)]);
     }
 
     #[test]
     fn empty_and_comment_only_give_no_points() {
-        assert!(parse_str("").unwrap().points.is_empty());
-        assert!(parse_str("# only\n\n   \nx,y\n").unwrap().points.is_empty());
+        assert!(parse_str("").unwrap().points().is_empty());
+        assert!(
+            parse_str("# only\n\n   \nx,y\n")
+                .unwrap()
+                .points()
+                .is_empty()
+        );
     }
 
     #[test]
@@ -388,8 +605,8 @@ mod tests {
         let text = format(&points);
         assert!(text.starts_with("x,y\n"));
         let back = parse_str(&text).unwrap();
-        assert_eq!(back.points.len(), points.len());
-        for (a, b) in points.iter().zip(&back.points) {
+        assert_eq!(back.points().len(), points.len());
+        for (a, b) in points.iter().zip(back.points()) {
             assert_eq!(a.x.to_bits(), b.x.to_bits());
             assert_eq!(a.y.to_bits(), b.y.to_bits());
         }

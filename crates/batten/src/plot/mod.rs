@@ -63,6 +63,7 @@
 mod axes;
 mod panels;
 mod sample;
+mod space;
 mod svg;
 
 use std::fmt;
@@ -70,6 +71,7 @@ use std::str::FromStr;
 
 use self::axes::Rect;
 use self::sample::{Sampled, XcData, function_frame, xc_data};
+pub use self::space::{SPACE_VIEWS, auto_space_comb_scale, render_space};
 use self::svg::Svg;
 use crate::error::{Error, Result};
 use crate::geom::PointSeq;
@@ -299,11 +301,39 @@ pub fn auto_comb_scale(input: &PointSeq, others: &[&PointSeq]) -> Result<f64> {
 }
 
 fn scale_for(input: &PointSeq, max_curvature: f64) -> f64 {
+    comb_scale_for(input.scale(), max_curvature)
+}
+
+/// The comb scale that draws the largest curvature as [`DEFAULT_COMB_FRACTION`] of a curve of
+/// size `size` (0 for a straight curve).
+pub(crate) fn comb_scale_for(size: f64, max_curvature: f64) -> f64 {
     if max_curvature > 0.0 && max_curvature.is_finite() {
-        DEFAULT_COMB_FRACTION * input.scale() / max_curvature
+        DEFAULT_COMB_FRACTION * size / max_curvature
     } else {
         0.0
     }
+}
+
+/// A faired curve drawn over an input must match it point for point, open or closed alike:
+/// `(len, closed)` of each.
+pub(crate) fn check_faired(faired: Option<(usize, bool)>, input: (usize, bool)) -> Result<()> {
+    let Some((len, closed)) = faired else {
+        return Ok(());
+    };
+    if len != input.0 {
+        return Err(Error::LengthMismatch {
+            what: "faired points",
+            got: len,
+            expected: input.0,
+        });
+    }
+    if closed != input.1 {
+        return Err(Error::InvalidParameter {
+            name: "faired".into(),
+            reason: "one curve is closed and the other open".into(),
+        });
+    }
+    Ok(())
 }
 
 /// Draw `input`, and `faired` over it when given, as an SVG document (see the
@@ -323,21 +353,10 @@ pub fn render(
     options: &PlotOptions,
 ) -> Result<String> {
     options.validate()?;
-    if let Some(f) = faired {
-        if f.len() != input.len() {
-            return Err(Error::LengthMismatch {
-                what: "faired points",
-                got: f.len(),
-                expected: input.len(),
-            });
-        }
-        if f.is_closed() != input.is_closed() {
-            return Err(Error::InvalidParameter {
-                name: "faired".into(),
-                reason: "one curve is closed and the other open".into(),
-            });
-        }
-    }
+    check_faired(
+        faired.map(|f| (f.len(), f.is_closed())),
+        (input.len(), input.is_closed()),
+    )?;
     if options.kind == PlotKind::Displacement && faired.is_none() {
         return Err(Error::InvalidParameter {
             name: "plot kind".into(),

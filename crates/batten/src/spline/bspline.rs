@@ -195,6 +195,13 @@ impl BSplineCurve {
             .find_span(self.degree, self.control_points.len(), t)
     }
 
+    /// [`BSplineCurve::find_span`] in a sweep over increasing parameters, walking on from
+    /// `from` (see [`KnotVector::find_span_from`]); the same span.
+    pub(crate) fn find_span_from(&self, t: f64, from: usize) -> usize {
+        self.knots
+            .find_span_from(self.degree, self.control_points.len(), t, from)
+    }
+
     /// The non-zero basis functions `N_{k−p..=k, p}` and their derivatives up to order `nd`
     /// at `t` in span `k`, written to `out[d][j]` (d = 0..=nd, j = 0..=p). The algorithm of
     /// Piegl & Tiller (A2.3), with 0/0 := 0 for repeated knots.

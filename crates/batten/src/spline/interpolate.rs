@@ -1,7 +1,7 @@
 //! Global B-spline interpolation through points (spec §4.3: chord-length parameters normalised
 //! to [0, 1], averaging knots, clamped ends; Piegl & Tiller §9.2.1).
 
-use super::{BSplineCurve, KnotVector, MAX_ORDER, Parametrization, parameters};
+use super::{BSplineCurve, KnotVector, MAX_ORDER, Parametrization, basis_derivs, parameters};
 use crate::error::{Error, Result};
 use crate::geom::Point;
 use crate::numeric::BandLu;
@@ -34,7 +34,42 @@ impl BSplineCurve {
                 got: n,
             });
         }
-        let mut t = parameters(points, param, false)?;
+        let t = parameters(points, param, false)?;
+        BSplineCurve::interpolate_at_parameters(points, p, t)
+    }
+
+    /// [`BSplineCurve::interpolate`] with the parameters of the points already computed
+    /// (`parameters(points, param, false)`, not yet normalised; the analysis curve of the
+    /// metrics has them): the same curve and parameters.
+    ///
+    /// # Errors
+    /// As [`BSplineCurve::interpolate`], less those of [`parameters`].
+    pub(crate) fn interpolate_at_parameters(
+        points: &[Point],
+        degree: usize,
+        mut t: Vec<f64>,
+    ) -> Result<(BSplineCurve, Vec<f64>)> {
+        let p = degree;
+        let n = points.len();
+        if p == 0 || p >= MAX_ORDER {
+            return Err(Error::InvalidParameter {
+                name: "degree".into(),
+                reason: format!("must be in 1..={}", MAX_ORDER - 1),
+            });
+        }
+        if n < p + 1 {
+            return Err(Error::TooFewPoints {
+                needed: p + 1,
+                got: n,
+            });
+        }
+        if t.len() != n {
+            return Err(Error::LengthMismatch {
+                what: "parameters",
+                got: t.len(),
+                expected: n,
+            });
+        }
         let total = t[n - 1];
         for v in &mut t {
             *v /= total;
@@ -46,13 +81,15 @@ impl BSplineCurve {
         }
         knots.extend(std::iter::repeat_n(1.0, p + 1));
         let knots = KnotVector::try_new(knots)?;
-        // Provisional curve to evaluate the basis (control points are replaced below).
-        let mut curve = BSplineCurve::try_new(p, knots, points.to_vec(), None)?;
+        // The collocation matrix from the knots alone (no provisional curve, no copy of the
+        // points), the data parameters swept in order; the curve is built once at the end,
+        // which validates it as before.
         let mut a = BandLu::zeros(n, p, p);
         let mut b = [[0.0; MAX_ORDER]; 4];
+        let mut span = p;
         for (row, &tk) in t.iter().enumerate() {
-            let span = curve.find_span(tk);
-            curve.basis_derivs(span, tk, 0, &mut b);
+            span = knots.find_span_from(p, n, tk, span);
+            basis_derivs(knots.as_slice(), p, span, tk, 0, &mut b);
             for j in 0..=p {
                 let col = span - p + j;
                 if col.abs_diff(row) <= p {
@@ -67,8 +104,9 @@ impl BSplineCurve {
         a.factorize()?;
         let mut rhs: Vec<_> = points.iter().map(|q| q.to_vec2()).collect();
         a.solve_in_place(&mut rhs)?;
+        drop(a);
         let ctrl = rhs.into_iter().map(|v| v.to_point()).collect();
-        curve = curve.with_control_points(ctrl)?;
+        let curve = BSplineCurve::try_new(p, knots, ctrl, None)?;
         Ok((curve, t))
     }
 }

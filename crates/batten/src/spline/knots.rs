@@ -118,6 +118,25 @@ impl KnotVector {
         lo
     }
 
+    /// [`KnotVector::find_span`] for parameters visited in increasing order: the search walks
+    /// forward from `from`, a span found for a smaller parameter, instead of bisecting. The
+    /// result is the same as [`KnotVector::find_span`]'s (the unique `k` with
+    /// `u_k ≤ t < u_{k+1}` inside the domain, the same clamping at its ends); O(1) amortised in
+    /// a sweep over sorted parameters.
+    pub(crate) fn find_span_from(&self, p: usize, n_ctrl: usize, t: f64, from: usize) -> usize {
+        let u = &self.0;
+        let hi = n_ctrl - 1;
+        if t >= u[hi + 1] || t <= u[p] || from < p || from > hi || u[from] > t {
+            return self.find_span(p, n_ctrl, t);
+        }
+        // u[from] ≤ t < u[hi + 1]: the walk stops at some k ≤ hi.
+        let mut k = from;
+        while u[k + 1] <= t {
+            k += 1;
+        }
+        k
+    }
+
     /// The Greville (Schoenberg, "correspondence") abscissae of a degree-`p` spline on these
     /// knots: `ξ_i = (u_{i+1} + … + u_{i+p}) / p`, one per control point (spec §0.5).
     pub fn greville(&self, p: usize) -> Vec<f64> {

@@ -23,3 +23,7 @@ pub use function::{CubicSplineFn, FnEndCondition};
 pub use knots::KnotVector;
 pub use lambda_operator::{LOCAL_HALF_WIDTH, LOCAL_WIDTH, LambdaOperator};
 pub use parametric::{EndCondition, ParametricCubic, Parametrization, parameters};
+pub(crate) use parametric::{
+    Ends, c2_closed_tangents, c2_tangents, hermite_coeffs, open_tangents, periodic_tangents,
+    span_derivatives,
+};

@@ -5,7 +5,9 @@ use serde::{Deserialize, Serialize};
 use crate::curve::{Curve, CurveDeriv, Derivatives, Piecewise};
 use crate::error::{Error, Result};
 use crate::geom::{Point, Vec2};
-use crate::numeric::{solve_cyclic_tridiagonal, solve_tridiagonal};
+use std::ops::Div;
+
+use crate::numeric::{Linear, solve_cyclic_tridiagonal, solve_tridiagonal};
 
 /// How parameter values are assigned to a point sequence (spec §0.2).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -104,63 +106,8 @@ impl ParametricCubic {
         points: &[Point],
         end: EndCondition,
     ) -> Result<ParametricCubic> {
-        let n = points.len();
-        let min = if matches!(end, EndCondition::NotAKnot) {
-            4
-        } else {
-            2
-        };
-        if n < min {
-            return Err(Error::TooFewPoints {
-                needed: min,
-                got: n,
-            });
-        }
-        check_params(t, n)?;
-        let dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-        let slope: Vec<Vec2> = (0..n - 1)
-            .map(|i| (points[i + 1] - points[i]) / dt[i])
-            .collect();
-        let mut sub = vec![0.0; n];
-        let mut diag = vec![0.0; n];
-        let mut sup = vec![0.0; n];
-        let mut rhs = vec![Vec2::ZERO; n];
-        for i in 1..n - 1 {
-            sub[i] = dt[i];
-            diag[i] = 2.0 * (dt[i - 1] + dt[i]);
-            sup[i] = dt[i - 1];
-            rhs[i] = (slope[i - 1] * dt[i] + slope[i] * dt[i - 1]) * 3.0;
-        }
-        match end {
-            EndCondition::Natural => {
-                diag[0] = 2.0;
-                sup[0] = 1.0;
-                rhs[0] = slope[0] * 3.0;
-                sub[n - 1] = 1.0;
-                diag[n - 1] = 2.0;
-                rhs[n - 1] = slope[n - 2] * 3.0;
-            }
-            EndCondition::Clamped(a, b) => {
-                diag[0] = 1.0;
-                rhs[0] = a;
-                diag[n - 1] = 1.0;
-                rhs[n - 1] = b;
-            }
-            EndCondition::NotAKnot => {
-                let d = t[2] - t[0];
-                diag[0] = dt[1];
-                sup[0] = d;
-                rhs[0] = (slope[0] * ((dt[0] + 2.0 * d) * dt[1]) + slope[1] * (dt[0] * dt[0])) / d;
-                let d = t[n - 1] - t[n - 3];
-                diag[n - 1] = dt[n - 3];
-                sub[n - 1] = d;
-                rhs[n - 1] = (slope[n - 3] * (dt[n - 2] * dt[n - 2])
-                    + slope[n - 2] * ((2.0 * d + dt[n - 2]) * dt[n - 3]))
-                    / d;
-            }
-        }
-        solve_tridiagonal(&sub, &diag, &sup, &mut rhs)?;
-        ParametricCubic::build(t.to_vec(), points.to_vec(), rhs, false)
+        let tangents = c2_tangents(t, points, end)?;
+        ParametricCubic::build(t.to_vec(), points.to_vec(), tangents, false)
     }
 
     /// The periodic C² cubic spline through a closed point sequence (the last point connects
@@ -169,31 +116,10 @@ impl ParametricCubic {
     /// # Errors
     /// [`Error::TooFewPoints`] (fewer than 3 points) and the errors of [`parameters`].
     pub fn closed(points: &[Point], param: Parametrization) -> Result<ParametricCubic> {
-        let n = points.len();
-        if n < 3 {
-            return Err(Error::TooFewPoints { needed: 3, got: n });
-        }
-        let t = parameters(points, param, true)?;
-        let dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect(); // n spans
-        let slope: Vec<Vec2> = (0..n)
-            .map(|i| (points[(i + 1) % n] - points[i]) / dt[i])
-            .collect();
-        let mut sub = vec![0.0; n];
-        let mut diag = vec![0.0; n];
-        let mut sup = vec![0.0; n];
-        let mut rhs = vec![Vec2::ZERO; n];
-        for i in 0..n {
-            let im = (i + n - 1) % n;
-            sub[i] = dt[i];
-            diag[i] = 2.0 * (dt[im] + dt[i]);
-            sup[i] = dt[im];
-            rhs[i] = (slope[im] * dt[i] + slope[i] * dt[im]) * 3.0;
-        }
-        solve_cyclic_tridiagonal(&sub, &diag, &sup, &mut rhs)?;
+        let (t, tangents) = c2_closed_tangents(points, param)?;
         let mut pts = points.to_vec();
         pts.push(points[0]);
-        rhs.push(rhs[0]);
-        ParametricCubic::build(t, pts, rhs, true)
+        ParametricCubic::build(t, pts, tangents, true)
     }
 
     /// A C¹ piecewise cubic Hermite curve from parameters, points and tangents (all of equal
@@ -236,8 +162,8 @@ impl ParametricCubic {
         let coeffs = (0..points.len() - 1)
             .map(|i| {
                 hermite_coeffs(
-                    points[i],
-                    points[i + 1],
+                    points[i].to_vec2(),
+                    points[i + 1].to_vec2(),
                     tangents[i],
                     tangents[i + 1],
                     t[i + 1] - t[i],
@@ -314,26 +240,179 @@ impl ParametricCubic {
     /// outside the span, giving the span polynomial's extension). For loops that walk the
     /// spans in order.
     pub fn derivatives_in_span(&self, i: usize, t: f64) -> Derivatives {
-        let [a0, a1, a2, a3] = self.coeffs[i];
-        let s = t - self.t[i];
-        let p = a0 + (a1 + (a2 + a3 * s) * s) * s;
-        let d1 = a1 + (a2 * 2.0 + a3 * (3.0 * s)) * s;
-        let d2 = a2 * 2.0 + a3 * (6.0 * s);
-        Derivatives {
-            point: p.to_point(),
-            d1,
-            d2,
-            d3: a3 * 6.0,
-        }
+        span_derivatives(&self.coeffs[i], t - self.t[i])
     }
 }
 
-/// KP eq 6: the power-basis coefficients of the cubic Hermite span.
-fn hermite_coeffs(p0: Point, p1: Point, d0: Vec2, d1: Vec2, h: f64) -> [Vec2; 4] {
+/// Position and derivatives of a span with power-basis coefficients `c` at `s = t − t_i`
+/// (for loops that form the coefficients one span at a time, as the metrics' span pass).
+#[inline]
+pub(crate) fn span_derivatives(c: &[Vec2; 4], s: f64) -> Derivatives {
+    let [a0, a1, a2, a3] = *c;
+    let p = a0 + (a1 + (a2 + a3 * s) * s) * s;
+    let d1 = a1 + (a2 * 2.0 + a3 * (3.0 * s)) * s;
+    let d2 = a2 * 2.0 + a3 * (6.0 * s);
+    Derivatives {
+        point: p.to_point(),
+        d1,
+        d2,
+        d3: a3 * 6.0,
+    }
+}
+
+/// The first derivatives at the knots of the C² interpolating cubic spline through `points`
+/// at the increasing parameters `t` ([`ParametricCubic::interpolate_at`] without the span
+/// coefficients, for the metrics' span pass that forms them one span at a time).
+///
+/// # Errors
+/// As [`ParametricCubic::interpolate_at`].
+pub(crate) fn c2_tangents(t: &[f64], points: &[Point], end: EndCondition) -> Result<Vec<Vec2>> {
+    let n = points.len();
+    let min = if matches!(end, EndCondition::NotAKnot) {
+        4
+    } else {
+        2
+    };
+    if n < min {
+        return Err(Error::TooFewPoints {
+            needed: min,
+            got: n,
+        });
+    }
+    check_params(t, n)?;
+    let dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    let slope: Vec<Vec2> = (0..n - 1)
+        .map(|i| (points[i + 1] - points[i]) / dt[i])
+        .collect();
+    let ends = match end {
+        EndCondition::Natural => Ends::Natural,
+        EndCondition::Clamped(a, b) => Ends::Clamped(a, b),
+        EndCondition::NotAKnot => Ends::NotAKnot,
+    };
+    open_tangents(t, &dt, &slope, ends)
+}
+
+/// The parameters and the first derivatives at the knots (the first repeated at the end) of
+/// the periodic C² cubic spline through a closed point sequence ([`ParametricCubic::closed`]
+/// without the span coefficients).
+///
+/// # Errors
+/// As [`ParametricCubic::closed`].
+pub(crate) fn c2_closed_tangents(
+    points: &[Point],
+    param: Parametrization,
+) -> Result<(Vec<f64>, Vec<Vec2>)> {
+    let n = points.len();
+    if n < 3 {
+        return Err(Error::TooFewPoints { needed: 3, got: n });
+    }
+    let t = parameters(points, param, true)?;
+    let dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect(); // n spans
+    let slope: Vec<Vec2> = (0..n)
+        .map(|i| (points[(i + 1) % n] - points[i]) / dt[i])
+        .collect();
+    let mut tangents = periodic_tangents(&dt, &slope)?;
+    tangents.push(tangents[0]);
+    Ok((t, tangents))
+}
+
+/// End conditions of [`open_tangents`], for values of any [`Linear`] type.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Ends<T> {
+    /// `r'' = 0` at both ends.
+    Natural,
+    /// Given first derivatives at the first and the last knot.
+    Clamped(T, T),
+    /// de Boor's not-a-knot (needs at least 4 knots).
+    NotAKnot,
+}
+
+/// The first derivatives at the knots `t` (spacings `dt`) of the C² cubic spline whose chord
+/// slopes are `slope` (`(P_{i+1} − P_i)/dt_i`, one fewer than knots), open with the given
+/// ends: the tridiagonal system of [`ParametricCubic::interpolate_at`], for values of any
+/// [`Linear`] type (plane points, space points, scalars alike).
+pub(crate) fn open_tangents<T: Linear + Div<f64, Output = T>>(
+    t: &[f64],
+    dt: &[f64],
+    slope: &[T],
+    end: Ends<T>,
+) -> Result<Vec<T>> {
+    let n = t.len();
+    let mut sub = vec![0.0; n];
+    let mut diag = vec![0.0; n];
+    let mut sup = vec![0.0; n];
+    let mut rhs = vec![T::default(); n];
+    for i in 1..n - 1 {
+        sub[i] = dt[i];
+        diag[i] = 2.0 * (dt[i - 1] + dt[i]);
+        sup[i] = dt[i - 1];
+        rhs[i] = (slope[i - 1] * dt[i] + slope[i] * dt[i - 1]) * 3.0;
+    }
+    match end {
+        Ends::Natural => {
+            diag[0] = 2.0;
+            sup[0] = 1.0;
+            rhs[0] = slope[0] * 3.0;
+            sub[n - 1] = 1.0;
+            diag[n - 1] = 2.0;
+            rhs[n - 1] = slope[n - 2] * 3.0;
+        }
+        Ends::Clamped(a, b) => {
+            diag[0] = 1.0;
+            rhs[0] = a;
+            diag[n - 1] = 1.0;
+            rhs[n - 1] = b;
+        }
+        Ends::NotAKnot => {
+            let d = t[2] - t[0];
+            diag[0] = dt[1];
+            sup[0] = d;
+            rhs[0] = (slope[0] * ((dt[0] + 2.0 * d) * dt[1]) + slope[1] * (dt[0] * dt[0])) / d;
+            let d = t[n - 1] - t[n - 3];
+            diag[n - 1] = dt[n - 3];
+            sub[n - 1] = d;
+            rhs[n - 1] = (slope[n - 3] * (dt[n - 2] * dt[n - 2])
+                + slope[n - 2] * ((2.0 * d + dt[n - 2]) * dt[n - 3]))
+                / d;
+        }
+    }
+    solve_tridiagonal(&sub, &diag, &sup, &mut rhs)?;
+    Ok(rhs)
+}
+
+/// The first derivatives at the knots of the periodic C² cubic spline with spacings `dt` and
+/// chord slopes `slope` (as many as points): the cyclic system of
+/// [`ParametricCubic::closed`], for values of any [`Linear`] type.
+pub(crate) fn periodic_tangents<T: Linear>(dt: &[f64], slope: &[T]) -> Result<Vec<T>> {
+    let n = dt.len();
+    let mut sub = vec![0.0; n];
+    let mut diag = vec![0.0; n];
+    let mut sup = vec![0.0; n];
+    let mut rhs = vec![T::default(); n];
+    for i in 0..n {
+        let im = (i + n - 1) % n;
+        sub[i] = dt[i];
+        diag[i] = 2.0 * (dt[im] + dt[i]);
+        sup[i] = dt[im];
+        rhs[i] = (slope[im] * dt[i] + slope[i] * dt[im]) * 3.0;
+    }
+    solve_cyclic_tridiagonal(&sub, &diag, &sup, &mut rhs)?;
+    Ok(rhs)
+}
+
+/// KP eq 6: the power-basis coefficients of the cubic Hermite span (`p0` and `p1` as position
+/// vectors), for values of any [`Linear`] type.
+pub(crate) fn hermite_coeffs<T: Linear + Div<f64, Output = T>>(
+    p0: T,
+    p1: T,
+    d0: T,
+    d1: T,
+    h: f64,
+) -> [T; 4] {
     let dp = p1 - p0;
     let a2 = dp * (3.0 / (h * h)) - (d0 * 2.0 + d1) / h;
     let a3 = dp * (-2.0 / (h * h * h)) + (d0 + d1) / (h * h);
-    [p0.to_vec2(), d0, a2, a3]
+    [p0, d0, a2, a3]
 }
 
 fn check_params(t: &[f64], n: usize) -> Result<()> {

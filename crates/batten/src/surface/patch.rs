@@ -7,8 +7,7 @@ use crate::error::{Error, Result};
 use crate::fair::local::principal_curvatures;
 use crate::spline::{KnotVector, MAX_ORDER, basis_derivs};
 
-/// A point or vector in space, `[x, y, z]`.
-pub type Xyz = [f64; 3];
+pub use crate::geom::Xyz;
 
 /// A tensor-product B-spline surface of degrees `(p, q)` on clamped knot vectors, with
 /// optional positive weights (NURBS).

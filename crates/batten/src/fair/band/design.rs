@@ -173,6 +173,66 @@ impl Design {
         }
     }
 
+    /// Call `add(row, col, value)` for the entries with `row ≥ col` of `Σ_i w_i B_iᵀ B_i`
+    /// (`w_i = weight(i)` on every coordinate, points with `skip[i]` left out): the blocks of
+    /// [`Design::for_each_block_lower`] when each is `w_i I`, at a quarter of the work in 2-D.
+    pub fn for_each_weight_lower<const D: usize>(
+        &self,
+        weight: impl Fn(usize) -> f64,
+        skip: &[bool],
+        mut add: impl FnMut(usize, usize, f64),
+    ) {
+        match self {
+            Design::Points { n } => {
+                for i in (0..*n).filter(|i| !skip[*i]) {
+                    let w = weight(i);
+                    for a in 0..D {
+                        add(i * D + a, i * D + a, w);
+                    }
+                }
+            }
+            Design::Spline(s) => {
+                let mut acc = [[0.0; 4]; 4];
+                let mut current = None;
+                let mut flush = |f: usize, acc: &mut [[f64; 4]; 4]| {
+                    for (k, row) in acc.iter_mut().enumerate() {
+                        let r0 = ((f + k) % s.vars) * D;
+                        for (l, v) in row.iter_mut().enumerate() {
+                            let c0 = ((f + l) % s.vars) * D;
+                            if r0 >= c0 {
+                                for a in 0..D {
+                                    add(r0 + a, c0 + a, *v);
+                                }
+                            }
+                            *v = 0.0;
+                        }
+                    }
+                };
+                for (i, (&f, b)) in s.first.iter().zip(&s.basis).enumerate() {
+                    if skip[i] {
+                        continue;
+                    }
+                    if current != Some(f) {
+                        if let Some(g) = current {
+                            flush(g, &mut acc);
+                        }
+                        current = Some(f);
+                    }
+                    let w = weight(i);
+                    for k in 0..4 {
+                        let wb = w * b[k];
+                        for l in 0..4 {
+                            acc[k][l] += wb * b[l];
+                        }
+                    }
+                }
+                if let Some(g) = current {
+                    flush(g, &mut acc);
+                }
+            }
+        }
+    }
+
     /// `out += Σ_i B_iᵀ M_i B_i v` (points with `skip[i]` left out); `work` holds `B v`.
     pub fn apply_blocks_add<const D: usize>(
         &self,
@@ -193,5 +253,58 @@ impl Design {
             work[i * D..(i + 1) * D].copy_from_slice(&mv);
         }
         self.eval_t_add::<D>(work, out);
+    }
+}
+
+#[cfg(test)]
+pub(super) mod tests {
+    use super::*;
+
+    /// A small spline map (cyclic when `closed`), with runs of points on each span and
+    /// uneven basis values.
+    pub fn map(closed: bool) -> SplineMap {
+        let vars = 7;
+        let spans = if closed { vars } else { vars - 3 };
+        let mut first = Vec::new();
+        let mut basis = Vec::new();
+        for span in 0..spans {
+            for j in 0..3 {
+                let u = (j as f64 + 0.5) / 3.0 + 0.01 * span as f64;
+                let b = [
+                    (1.0 - u).powi(3) / 6.0,
+                    (3.0 * u.powi(3) - 6.0 * u * u + 4.0) / 6.0,
+                    (-3.0 * u.powi(3) + 3.0 * u * u + 3.0 * u + 1.0) / 6.0,
+                    u.powi(3) / 6.0,
+                ];
+                first.push(span);
+                basis.push(b);
+            }
+        }
+        SplineMap { vars, first, basis }
+    }
+
+    /// The scalar-weight Gram matrix equals the block one with blocks `w_i I`.
+    #[test]
+    fn weight_gram_matches_blocks() {
+        for closed in [false, true] {
+            let design = Design::Spline(map(closed));
+            let n = design.points();
+            let weight = |i: usize| 1.0 + (i as f64 * 0.7).sin().abs();
+            let skip: Vec<bool> = (0..n).map(|i| i % 5 == 2).collect();
+            let blocks: Vec<[[f64; 2]; 2]> = (0..n)
+                .map(|i| [[weight(i), 0.0], [0.0, weight(i)]])
+                .collect();
+            let dim = 2 * design.vars();
+            let mut want = vec![0.0; dim * dim];
+            design.for_each_block_lower::<2>(&blocks, &skip, |r, c, v| want[r * dim + c] += v);
+            let mut got = vec![0.0; dim * dim];
+            design.for_each_weight_lower::<2>(weight, &skip, |r, c, v| {
+                assert!(r >= c);
+                got[r * dim + c] += v;
+            });
+            for (g, w) in got.iter().zip(&want) {
+                assert!((g - w).abs() < 1e-14, "{g} {w}");
+            }
+        }
     }
 }

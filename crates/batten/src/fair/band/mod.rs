@@ -30,7 +30,7 @@
 //!
 //! `--tolerance D`, or by default `D = k·σ̂` (`k = max(3, √(2 ln n))`, [`auto_k`]; `--set k=`),
 //! with `σ̂` the noise estimate
-//! of [`crate::analysis::noise_sigma`] (median absolute third difference along the local
+//! of [`crate::analysis::noise_sigma`] (median absolute fifth difference along the local
 //! normal). The report gives `noise_sigma`, the `tolerance` and `tolerance_source`.
 //!
 //! # The solver
@@ -43,6 +43,12 @@
 //! O(1) at any scale. The result is put into the band exactly (`max_displacement ≤ D`
 //! always). The report's `solver` gives the iterations, the final duality gap and the number of
 //! points on the band's edge.
+//!
+//! # Space curves
+//!
+//! Everything above is generic over the dimension: [`crate::fair::fair_space`] runs the same
+//! passes on 3-D points (the band's cones become 3-D, `|q_i − p_i| ≤ D` in 3-D distance),
+//! with σ̂ from [`crate::analysis::noise_sigma_space`] and the same parameters and notes.
 
 mod debias;
 mod design;
@@ -51,6 +57,7 @@ mod form;
 mod params;
 mod solver;
 mod spline;
+mod working_set;
 
 #[cfg(test)]
 mod reference_tests;
@@ -60,9 +67,9 @@ use serde_json::{Map, Value};
 use crate::error::{Error, Result};
 use crate::fair::{
     AUTO_TOLERANCE_K, FairMethod, FairOptions, FairStatus, HistoryRow, Outcome, ParamSpec,
-    SolverInfo,
+    SolverInfo, SpaceOutcome,
 };
-use crate::geom::{Point, PointSeq};
+use crate::geom::{Point, PointSeq, SpaceSeq};
 
 use debias::{ENERGY_CAP, Penalized};
 use energy::{Energy, Metric};
@@ -138,97 +145,126 @@ impl FairMethod for Band {
     }
 
     fn run(&self, input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
-        let params = BandParams::from_options(options)?;
-        let tolerance = options.tolerance.ok_or_else(|| Error::InvalidParameter {
-            name: "tolerance".into(),
-            reason: "band needs a tolerance (the common path gives it k·σ̂ when none is given)"
-                .into(),
-        })?;
         let pts: Vec<[f64; 2]> = input.points().iter().map(|p| [p.x, p.y]).collect();
         let closed = input.is_closed();
-        if closed && pts.len() < MIN_CLOSED_POINTS {
-            return Err(Error::InvalidParameter {
-                name: "input".into(),
-                reason: format!(
-                    "band needs at least {MIN_CLOSED_POINTS} points on a closed curve, got {}",
-                    pts.len()
-                ),
-            });
-        }
-        let held = held_mask(pts.len(), closed, options.fix_ends.held());
-        let noise = crate::analysis::noise_sigma(input.points(), closed);
-        let faired = fair_points(&pts, closed, &held, tolerance, noise, &params)?;
-        let mut parameters = Map::new();
-        match params.k {
-            Some(k) => parameters.insert("k".into(), Value::from(k)),
-            None => parameters.insert("k".into(), Value::from("auto")),
-        };
-        parameters.insert(
-            "energy".into(),
-            Value::from(match params.metric {
-                Metric::Jerk => "jerk",
-                Metric::MinVariation { .. } => "min-variation",
-            }),
-        );
-        if let Metric::MinVariation { eps, speed } = params.metric {
-            parameters.insert("eps".into(), Value::from(eps));
-            parameters.insert("speed".into(), Value::from(speed));
-        }
-        parameters.insert("passes".into(), Value::from(params.passes));
-        parameters.insert("fit".into(), Value::from(params.fit));
-        parameters.insert("local".into(), Value::from(params.local));
-        let mut notes: Vec<String> = faired
-            .fidelity
-            .map(|(mu, raised)| {
-                format!(
-                    "debiasing stage: data weight {mu:.3e} (in units of the tolerance and the \
-                     mean spacing), for a mean residual of {}·σ̂ = {:.6e}; raised at {raised} \
-                     of {} points where the residual was biased",
-                    params.fit,
-                    params.fit * noise,
-                    pts.len()
-                )
-            })
-            .into_iter()
-            .collect();
-        if let Some(vars) = faired.spline {
-            notes.push(format!(
-                "dense points: solved in the spline form, a cubic B-spline with {vars} control \
-                 points through which every point is taken (see docs/algorithms/band.md, \
-                 Dense points)"
-            ));
-        }
-        if let Some(gap) = faired.stalled {
-            notes.push(format!(
-                "the solver stopped short of its stopping rule: rounding stopped its progress at \
-                 a relative duality gap of {gap:.1e}; the result is inside the band but may \
-                 not be the fairest one. This happens when the points are dense against the \
-                 noise (the energy's long waves fall below double precision); see \
-                 docs/algorithms/band.md, Limits"
-            ));
-        }
-        let points: Vec<Point> = faired
-            .points
-            .iter()
-            .map(|q| Point::new(q[0], q[1]))
-            .collect();
-        Ok(Outcome {
-            points,
-            status: if faired.converged {
-                FairStatus::Converged
-            } else if faired.stalled.is_some() {
-                FairStatus::Stalled
-            } else {
-                FairStatus::IterationLimit
-            },
-            iterations: faired.solver.iterations,
-            history: faired.history,
-            parameters,
-            solver: Some(faired.solver),
-            notes,
-            ..Outcome::default()
-        })
+        let (faired, mut outcome) = run_points(&pts, closed, options, || {
+            (crate::analysis::noise_sigma(input.points(), closed), 2)
+        })?;
+        outcome.points = faired.iter().map(|q| Point::new(q[0], q[1])).collect();
+        Ok(outcome)
     }
+
+    fn run_space(&self, input: &SpaceSeq, options: &FairOptions) -> Option<Result<SpaceOutcome>> {
+        let closed = input.is_closed();
+        let run = run_points(input.points(), closed, options, || {
+            let pts = input.points();
+            let dims = if crate::analysis::is_planar(pts) {
+                2
+            } else {
+                3
+            };
+            (crate::analysis::noise_sigma_space(pts, closed), dims)
+        });
+        Some(run.map(|(points, outcome)| SpaceOutcome::from_parts(points, outcome)))
+    }
+
+    fn run_space_supported(&self) -> bool {
+        true
+    }
+}
+
+/// `band` on points of any dimension (the planar method and the space one): the faired
+/// points, and the rest of the outcome (its `points` left empty). `noise` gives σ̂ of the
+/// input and the number of coordinates the noise lies in (the debiasing stage's target: 2
+/// for points in one plane, also in space), asked once the input has passed its checks.
+fn run_points<const D: usize>(
+    pts: &[[f64; D]],
+    closed: bool,
+    options: &FairOptions,
+    noise: impl FnOnce() -> (f64, usize),
+) -> Result<(Vec<[f64; D]>, Outcome)> {
+    let params = BandParams::from_options(options)?;
+    let tolerance = options.tolerance.ok_or_else(|| Error::InvalidParameter {
+        name: "tolerance".into(),
+        reason: "band needs a tolerance (the common path gives it k·σ̂ when none is given)".into(),
+    })?;
+    if closed && pts.len() < MIN_CLOSED_POINTS {
+        return Err(Error::InvalidParameter {
+            name: "input".into(),
+            reason: format!(
+                "band needs at least {MIN_CLOSED_POINTS} points on a closed curve, got {}",
+                pts.len()
+            ),
+        });
+    }
+    let held = held_mask(pts.len(), closed, options.fix_ends.held());
+    let (noise, noise_dims) = noise();
+    let faired = fair_points(pts, closed, &held, tolerance, (noise, noise_dims), &params)?;
+    let mut parameters = Map::new();
+    match params.k {
+        Some(k) => parameters.insert("k".into(), Value::from(k)),
+        None => parameters.insert("k".into(), Value::from("auto")),
+    };
+    parameters.insert(
+        "energy".into(),
+        Value::from(match params.metric {
+            Metric::Jerk => "jerk",
+            Metric::MinVariation { .. } => "min-variation",
+        }),
+    );
+    if let Metric::MinVariation { eps, speed } = params.metric {
+        parameters.insert("eps".into(), Value::from(eps));
+        parameters.insert("speed".into(), Value::from(speed));
+    }
+    parameters.insert("passes".into(), Value::from(params.passes));
+    parameters.insert("fit".into(), Value::from(params.fit));
+    parameters.insert("local".into(), Value::from(params.local));
+    let mut notes: Vec<String> = faired
+        .fidelity
+        .map(|(mu, raised)| {
+            format!(
+                "debiasing stage: data weight {mu:.3e} (in units of the tolerance and the \
+                 mean spacing), for a mean residual of {}·σ̂ = {:.6e}; raised at {raised} \
+                 of {} points where the residual was biased",
+                params.fit,
+                params.fit * noise,
+                pts.len()
+            )
+        })
+        .into_iter()
+        .collect();
+    if let Some(vars) = faired.spline {
+        notes.push(format!(
+            "dense points: solved in the spline form, a cubic B-spline with {vars} control \
+             points through which every point is taken (see docs/algorithms/band.md, \
+             Dense points)"
+        ));
+    }
+    if let Some(gap) = faired.stalled {
+        notes.push(format!(
+            "the solver stopped short of its stopping rule: rounding stopped its progress at \
+             a relative duality gap of {gap:.1e}; the result is inside the band but may \
+             not be the fairest one. This happens when the points are dense against the \
+             noise (the energy's long waves fall below double precision); see \
+             docs/algorithms/band.md, Limits"
+        ));
+    }
+    let outcome = Outcome {
+        status: if faired.converged {
+            FairStatus::Converged
+        } else if faired.stalled.is_some() {
+            FairStatus::Stalled
+        } else {
+            FairStatus::IterationLimit
+        },
+        iterations: faired.solver.iterations,
+        history: faired.history,
+        parameters,
+        solver: Some(faired.solver),
+        notes,
+        ..Outcome::default()
+    };
+    Ok((faired.points, outcome))
 }
 
 /// Which points are held: `held` at each end of an open curve.
@@ -264,12 +300,14 @@ struct Faired<const D: usize> {
 pub const DENSE_POINTS: usize = 2000;
 
 /// Run the passes on points of any dimension and put the result into the band exactly.
+/// `(noise_sigma, noise_dims)`: σ̂ per coordinate and the number of coordinates the noise
+/// lies in (the debiasing stage's target is a mean squared residual of `noise_dims·(fit·σ̂)²`).
 fn fair_points<const D: usize>(
     pts: &[[f64; D]],
     closed: bool,
     held: &[bool],
     tolerance: f64,
-    noise_sigma: f64,
+    (noise_sigma, noise_dims): (f64, usize),
     params: &BandParams,
 ) -> Result<Faired<D>> {
     let n = pts.len();
@@ -353,7 +391,7 @@ fn fair_points<const D: usize>(
             &problem.centres,
         );
         let scaled_noise = params.fit * noise_sigma / tolerance;
-        let target = D as f64 * scaled_noise * scaled_noise;
+        let target = noise_dims as f64 * scaled_noise * scaled_noise;
         let anchor_energy = problem.anchor_energy;
         let cap = ENERGY_CAP * anchor_energy;
         if let Some(mu) = fit.discrepancy_weight(anchor_energy, target, cap)? {
@@ -431,11 +469,21 @@ fn band_problem<'a, const D: usize>(
     }
 }
 
-/// The largest distance of a point of `shape` from its input point.
+/// The largest distance of a point of `shape` from its input point, by [`distance`]: the
+/// squared distances pick the candidates (within rounding of the largest), which are then
+/// measured exactly.
 fn farthest<const D: usize>(shape: &[[f64; D]], pts: &[[f64; D]]) -> f64 {
+    let square = |q: &[f64; D], p: &[f64; D]| (0..D).map(|a| (q[a] - p[a]).powi(2)).sum::<f64>();
+    let top = shape
+        .iter()
+        .zip(pts)
+        .map(|(q, p)| square(q, p))
+        .fold(0.0_f64, f64::max);
+    let near = top * (1.0 - 1e-12);
     shape
         .iter()
         .zip(pts)
+        .filter(|(q, p)| square(q, p) >= near)
         .map(|(q, p)| distance(q, p))
         .fold(0.0_f64, f64::max)
 }
@@ -572,6 +620,12 @@ fn into_band<const D: usize>(pts: &[[f64; D]], r: &[f64], tolerance: f64) -> Vec
         .map(|(i, p)| {
             let ri = &r[i * D..(i + 1) * D];
             let len = ri.iter().map(|v| v * v).sum::<f64>().sqrt();
+            // Clearly inside, rounding of `q` and of its distance included (a few units in
+            // the last place of the coordinates and of `D`; 16 of them here): no check needed.
+            let size = p.iter().fold(tolerance, |m, v| m.max(v.abs()));
+            if len <= 1.0 - 16.0 * f64::EPSILON * (1.0 + size / tolerance) {
+                return std::array::from_fn(|a| p[a] + tolerance * ri[a]);
+            }
             let mut shrink = if len > 1.0 { 1.0 / len } else { 1.0 };
             // Far from the origin the rounding of `q` is large against `D`: the cut doubles
             // at each try, from 4 units in the last place.

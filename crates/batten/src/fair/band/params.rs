@@ -83,10 +83,7 @@ impl BandParams {
     /// # Errors
     /// [`crate::Error::InvalidParameter`] naming the parameter and its range.
     pub fn from_options(options: &FairOptions) -> Result<BandParams> {
-        let k = match options.params.get("k").map(|s| s.trim()) {
-            None | Some("auto") => None,
-            Some(_) => Some(options.param_f64_in("k", 3.0, f64::MIN_POSITIVE, 100.0)?),
-        };
+        let k = options.param_auto_f64_in("k", f64::MIN_POSITIVE, 100.0)?;
         let eps = options.param_f64_in("eps", DEFAULT_EPS, 0.0, 10.0)?;
         let speed = options.param_f64_in("speed", DEFAULT_SPEED, 0.0, 1e6)?;
         let metric =

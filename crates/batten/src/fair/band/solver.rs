@@ -308,12 +308,24 @@ struct State<const D: usize> {
     sig: Vec<f64>,
 }
 
-/// Solve the band problem.
+/// Solve the band problem: the spline form on a working set of its points
+/// (`working_set.rs`), the point form directly.
 ///
 /// # Errors
 /// [`Error::Singular`] if a Newton matrix has non-finite entries (it cannot happen for
 /// finite input).
 pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
+    match (p.design, &p.start) {
+        (Design::Spline(map), Some(start)) => super::working_set::solve(p, map, start),
+        _ => solve_all(p),
+    }
+}
+
+/// Solve the band problem with every point's constraint in every iteration.
+///
+/// # Errors
+/// As [`solve`].
+pub(super) fn solve_all<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
     let energy = p.energy;
     let design = p.design;
     // `n` points (constraints), `dim` unknowns.
