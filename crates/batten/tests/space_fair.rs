@@ -166,14 +166,23 @@ proptest! {
             let out = fair_space(method, &moved, &moved_opts).unwrap();
             let expected: Vec<Xyz> = base.points.iter().map(map).collect();
             let off = max_move(&expected, &out.points);
-            // band's stopping rule bounds the objective's relative gap (1e-9), not the
-            // points: along the energy's flattest directions they are known to about its
-            // square root. CI's random case (kept as a regression seed: a turn about z at
-            // scale 1e-3) differed by 1.9e-6·D, so the bound is 1e-5·D.
+            // band's stopping rule bounds the relative duality gap (1e-9) and the dual
+            // residual (1e-9 of its terms), which fix every pass's energy, not the points:
+            // along the energy's flattest direction (points sliding along the curve, weighed
+            // by nothing but ε of the jerk) that residual leaves them free to about 1e-4·D,
+            // and each pass takes its metric from the last. Over 60 random motions the points
+            // agreed to 2e-6·D but for CI's two cases (kept as regression seeds: turns about
+            // z), 1.9e-6·D and 5.1e-5·D, with the energies of every pass within 3e-9.
             prop_assert!(
-                off <= 1e-5 * scale * tol,
+                off <= 1e-3 * scale * tol,
                 "{method}: off by {off:e} at scale {scale}"
             );
+            // band's energies are in units of the tolerance and the spacing: scale free.
+            let band_energies = if method == "band" { base.report.history.len() } else { 0 };
+            for (a, b) in base.report.history.iter().zip(&out.report.history).take(band_energies) {
+                let rel = (a.measure - b.measure).abs() / a.measure.abs().max(f64::MIN_POSITIVE);
+                prop_assert!(rel <= 1e-7, "{method}: energy {} against {}", a.measure, b.measure);
+            }
         }
     }
 }
@@ -406,4 +415,37 @@ fn a_dense_noisy_helix_timing() {
         rms(&out.points, &exact)
     );
     assert!(out.report.tolerance_met);
+}
+
+/// Once the gap met the stopping rule, a corrector that still aimed it at zero made the Newton
+/// matrix singular at the band's edge (λ/σ without bound), and the dual residual then stalled
+/// just above its bound: this turned helix (CI's case) ran two of its three passes to the
+/// iteration limit, 416 solver iterations against 50 unturned. The corrector now keeps the gap
+/// at a tenth of the rule's: 87.
+#[test]
+fn a_turned_helix_does_not_run_to_the_iteration_limit() {
+    let (input, _) = noisy(90, 0.02, 3973364763628303186, false);
+    let m = rotation([0.0, 0.0, 0.1], 1.6463812537942832);
+    let turned = SpaceSeq::new(
+        input
+            .points()
+            .iter()
+            .map(|p| apply(&m, 1.0, [0.0; 3], p))
+            .collect(),
+        false,
+    )
+    .unwrap();
+    let out = fair_space(
+        "band",
+        &turned,
+        &FairOptions::default().with_tolerance(0.05),
+    )
+    .unwrap();
+    assert_eq!(out.report.status, FairStatus::Converged);
+    let solver = out.report.solver.unwrap();
+    assert!(
+        solver.iterations < 150,
+        "{} solver iterations",
+        solver.iterations
+    );
 }

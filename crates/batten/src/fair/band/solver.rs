@@ -57,6 +57,8 @@ const OBJECTIVE_FLOOR: f64 = 1e-12;
 const GRADIENT_FLOOR: f64 = 1e-9;
 /// Stop when the surrogate duality gap is below this fraction of the objective (or of 1).
 pub(super) const GAP_REL: f64 = 1e-9;
+/// The lowest complementarity gap a corrector aims at, as a fraction of [`GAP_REL`].
+const GAP_TARGET_FLOOR: f64 = 0.1;
 /// When rounding stops progress, the run still counts as converged if the gap is below this
 /// fraction of the objective.
 const ACCEPT_GAP_REL: f64 = 1e-6;
@@ -517,6 +519,12 @@ pub(super) fn solve_all<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> 
             }
         }
         let centring = (gap_aff / gap).clamp(0.0, 1.0).powi(3);
+        // The gap aimed at: Mehrotra's, but not below a tenth of the stopping rule's. Once the
+        // gap meets the rule, what is left is the dual residual, which full steps at the same
+        // gap remove; pushing the gap on towards zero instead makes the Newton matrix
+        // singular (λ/σ without bound at the band's edge), and the residual then stays where
+        // rounding leaves it while the points drift along the energy's flattest directions.
+        let target = (centring * mu).max(GAP_TARGET_FLOOR * GAP_REL * scale / free as f64);
 
         // Corrector: the second-order terms of the predictor, centred at `centring · μ`. Two
         // of them: `Δλ Δσ` in the complementarity (Mehrotra) and `|Δr|²` in the constraint,
@@ -528,7 +536,7 @@ pub(super) fn solve_all<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> 
                 rp[i] = 0.0;
                 continue;
             }
-            rc[i] = st.lam[i] * st.sig[i] + dlam[i] * dsig[i] - centring * mu;
+            rc[i] = st.lam[i] * st.sig[i] + dlam[i] * dsig[i] - target;
             let slide: f64 = (0..D).map(|a| dr[i * D + a] * dr[i * D + a]).sum();
             rp[i] = alpha_aff * slide;
         }
