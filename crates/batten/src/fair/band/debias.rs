@@ -293,8 +293,9 @@ impl<'a, const D: usize> Penalized<'a, D> {
 
     /// The data weight `μ` of the discrepancy principle: the smallest `μ` (in the bracket)
     /// whose minimiser's mean squared residual is at most `target`, or whose energy reaches
-    /// `cap` (`E(s)` is the energy of the reference, the passes' result). `None` when the
-    /// reference already meets the target (nothing to debias) or no `μ` helps.
+    /// `cap` (`E(s)` is the energy of the reference, the passes' result); the smallest `μ`
+    /// of the bracket when that one meets the target already. `None` when the reference
+    /// already meets the target (nothing to debias) or the smallest `μ` reaches the cap.
     pub fn discrepancy_weight(
         &self,
         anchor_energy: f64,
@@ -321,19 +322,25 @@ impl<'a, const D: usize> Penalized<'a, D> {
         );
 
         // A weight so small that rounding makes the matrix singular (the energy's null space,
-        // quadratics in the parameter, rests on `μ` alone) asks for more weight too.
+        // quadratics in the parameter, rests on `μ` alone) asks for more weight too. `None`:
+        // the minimiser's energy reaches the cap.
         let more_data = |ln_mu: f64| match self.minimiser(|_| ln_mu.exp(), true) {
-            Ok(y) => {
-                self.mean_square_residual(&y) > target && self.energy_at(&y, anchor_energy) < cap
-            }
-            Err(_) => true,
+            Ok(y) => (self.energy_at(&y, anchor_energy) < cap)
+                .then(|| self.mean_square_residual(&y) > target),
+            Err(_) => Some(true),
         };
-        if !more_data(lo) {
-            return Ok(None);
+        match more_data(lo) {
+            None => return Ok(None),
+            // The smoothest weight that rounding leaves meaningful meets the target already:
+            // the reference, held by the band at a few points, is farther from the data than
+            // a smooth fit. That weight is the answer (the stage used to be skipped there,
+            // and dense noisy curves kept the passes' flattened features).
+            Some(false) => return Ok(Some(lo.exp())),
+            Some(true) => {}
         }
         for _ in 0..BISECTIONS {
             let mid = 0.5 * (lo + hi);
-            if more_data(mid) {
+            if more_data(mid) == Some(true) {
                 lo = mid;
             } else {
                 hi = mid;
