@@ -2,6 +2,7 @@
 
 use crate::curve::{CurveDeriv, Piecewise};
 use crate::numeric::GaussLegendre;
+use crate::spline::break_span;
 
 /// Total arc length of a piecewise curve.
 pub fn arc_length<C: CurveDeriv + Piecewise + ?Sized>(curve: &C) -> f64 {
@@ -49,14 +50,7 @@ impl ArcLengthTable {
     }
 
     fn span_of_t(&self, t: f64) -> usize {
-        let n = self.breaks.len();
-        if n < 2 {
-            return 0;
-        }
-        match self.breaks.binary_search_by(|k| k.total_cmp(&t)) {
-            Ok(i) => i.min(n - 2),
-            Err(i) => i.saturating_sub(1).min(n - 2),
-        }
+        break_span(&self.breaks, t)
     }
 
     /// Arc length from the start of the domain to parameter `t`.

@@ -10,7 +10,7 @@ use std::ops::{Add, Div, Mul, Sub};
 use crate::error::{Error, Result};
 use crate::geom::{SpaceSeq, Xyz};
 use crate::numeric::{GaussLegendre, Linear};
-use crate::spline::{Ends, hermite_coeffs, open_tangents, periodic_tangents};
+use crate::spline::{Ends, break_span, hermite_coeffs, open_tangents, periodic_tangents};
 
 /// A space vector with the arithmetic the crate's linear solvers need.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -257,11 +257,7 @@ impl SpaceCubic {
 
     /// The span containing `t` (clamped to the first and last span).
     pub fn find_span(&self, t: f64) -> usize {
-        let n = self.coeffs.len();
-        match self.t.binary_search_by(|k| k.total_cmp(&t)) {
-            Ok(i) => i.min(n - 1),
-            Err(i) => i.saturating_sub(1).min(n - 1),
-        }
+        break_span(&self.t, t)
     }
 
     /// Position and derivatives at `t` on span `i` (no span search; outside the span this is

@@ -171,9 +171,37 @@ impl From<KnotVector> for Vec<f64> {
     }
 }
 
+/// The span of a piecewise curve with increasing breakpoints `breaks` (at least two) that
+/// contains `t`: the `i` with `breaks[i] ≤ t < breaks[i + 1]`, the last span at its end
+/// break, and clamped to the first and last span outside the domain.
+pub(crate) fn break_span(breaks: &[f64], t: f64) -> usize {
+    let last = breaks.len().saturating_sub(2);
+    match breaks.binary_search_by(|k| k.total_cmp(&t)) {
+        Ok(i) => i.min(last),
+        Err(i) => i.saturating_sub(1).min(last),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn break_span_finds_and_clamps() {
+        let b = [0.0, 1.0, 2.0, 3.0];
+        for (t, want) in [
+            (-1.0, 0),
+            (0.0, 0),
+            (0.5, 0),
+            (1.0, 1),
+            (2.5, 2),
+            (3.0, 2),
+            (4.0, 2),
+        ] {
+            assert_eq!(break_span(&b, t), want, "t = {t}");
+        }
+        assert_eq!(break_span(&[0.0, 1.0], 5.0), 0);
+    }
 
     #[test]
     fn validation() {

@@ -21,6 +21,7 @@ pub use bspline::{BSplineCurve, MAX_ORDER};
 pub use bspline_ops::{DEVIATION_SAMPLES_PER_SPAN, KnotRef, KnotRemoval, RemovalRule};
 pub use function::{CubicSplineFn, FnEndCondition};
 pub use knots::KnotVector;
+pub(crate) use knots::break_span;
 pub use lambda_operator::{LOCAL_HALF_WIDTH, LOCAL_WIDTH, LambdaOperator};
 pub use parametric::{EndCondition, ParametricCubic, Parametrization, parameters};
 pub(crate) use parametric::{

@@ -7,6 +7,7 @@ use crate::error::{Error, Result};
 use crate::geom::{Point, Vec2};
 use std::ops::Div;
 
+use super::knots::break_span;
 use crate::numeric::{Linear, solve_cyclic_tridiagonal, solve_tridiagonal};
 
 /// How parameter values are assigned to a point sequence (spec §0.2).
@@ -214,11 +215,7 @@ impl ParametricCubic {
 
     /// The span containing `t` (clamped to the first and last span).
     pub fn find_span(&self, t: f64) -> usize {
-        let n = self.coeffs.len();
-        match self.t.binary_search_by(|k| k.total_cmp(&t)) {
-            Ok(i) => i.min(n - 1),
-            Err(i) => i.saturating_sub(1).min(n - 1),
-        }
+        break_span(&self.t, t)
     }
 
     /// Jumps `r'''(t_k+) − r'''(t_k−) = 6(a_{k,3} − a_{k−1,3})` at the interior knots
