@@ -68,6 +68,20 @@ impl Range {
         r
     }
 
+    /// The smallest ranges of the first and of the second coordinates of the pairs whose
+    /// both coordinates are finite, or zero-width ranges at 0 when there is none.
+    pub(crate) fn of_pairs(pairs: impl IntoIterator<Item = (f64, f64)>) -> (Range, Range) {
+        let (mut xr, mut yr): (Option<Range>, Option<Range>) = (None, None);
+        for (x, y) in pairs {
+            if x.is_finite() && y.is_finite() {
+                xr = Some(xr.map_or(Range { lo: x, hi: x }, |r| r.including(x)));
+                yr = Some(yr.map_or(Range { lo: y, hi: y }, |r| r.including(y)));
+            }
+        }
+        let zero = Range { lo: 0.0, hi: 0.0 };
+        (xr.unwrap_or(zero), yr.unwrap_or(zero))
+    }
+
     /// The union of two ranges.
     pub(crate) fn union(self, o: Range) -> Range {
         Range {

@@ -29,7 +29,7 @@ const DOT_MAX: f64 = 3.5;
 const COMB_PAD: f64 = 0.04;
 
 /// A legend label for `shown` of `total` things.
-fn count_label(what: &str, shown: usize, total: usize) -> String {
+pub(super) fn count_label(what: &str, shown: usize, total: usize) -> String {
     if shown < total {
         format!("{what} ({shown} of {total} shown)")
     } else {
@@ -79,20 +79,13 @@ pub(crate) fn comb(svg: &mut Svg, outer: Rect, series: &[&Sampled], scale: f64, 
         .iter()
         .map(|s| s.by_arc_length(MAX_VERTICES))
         .collect();
-    let (mut xr, mut yr): (Option<Range>, Option<Range>) = (None, None);
-    for (s, idx) in series.iter().zip(&env) {
+    let (xr, yr) = Range::of_pairs(series.iter().zip(&env).flat_map(|(s, idx)| {
         let b = s.seq.bbox();
-        let pts = idx
-            .iter()
+        idx.iter()
             .flat_map(|&i| [s.comb[i].point, tip(s, i, scale)])
-            .chain([b.min, b.max]);
-        for p in pts.filter(|p| p.is_finite()) {
-            xr = Some(xr.map_or(Range { lo: p.x, hi: p.x }, |r| r.including(p.x)));
-            yr = Some(yr.map_or(Range { lo: p.y, hi: p.y }, |r| r.including(p.y)));
-        }
-    }
-    let zero = Range { lo: 0.0, hi: 0.0 };
-    let (xr, yr) = (xr.unwrap_or(zero), yr.unwrap_or(zero));
+            .chain([b.min, b.max])
+            .map(|p| (p.x, p.y))
+    }));
     let mut legend = Vec::new();
     for (k, s) in series.iter().enumerate() {
         let n = s.seq.len();

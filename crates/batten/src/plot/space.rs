@@ -17,6 +17,7 @@
 //! an SVG under a megabyte.
 
 use super::axes::{self, Frame, GRAPH_PAD, LegendItem, Range, Rect, Swatch, sig3};
+use super::panels::count_label;
 use super::sample::{min_max_indices, select_by_arc_length, stride_indices};
 use super::svg::{PathData, Svg};
 use super::{MAX_DOTS, MAX_TEETH, MAX_VERTICES, PlotOptions};
@@ -225,20 +226,11 @@ fn view_panel(
     (title, [a, b], labels): &(&str, [usize; 2], [&str; 2]),
 ) {
     let (a, b) = (*a, *b);
-    let mut xr: Option<Range> = None;
-    let mut yr: Option<Range> = None;
-    for s in series {
+    let (xr, yr) = Range::of_pairs(series.iter().flat_map(|s| {
         let (lo, hi) = s.seq.bounds();
         let tips = s.view_vertices.iter().map(|&i| s.tip(i, scale));
-        for p in tips.chain([lo, hi]) {
-            if p[a].is_finite() && p[b].is_finite() {
-                xr = Some(xr.map_or(Range { lo: p[a], hi: p[a] }, |r| r.including(p[a])));
-                yr = Some(yr.map_or(Range { lo: p[b], hi: p[b] }, |r| r.including(p[b])));
-            }
-        }
-    }
-    let zero = Range { lo: 0.0, hi: 0.0 };
-    let (xr, yr) = (xr.unwrap_or(zero), yr.unwrap_or(zero));
+        tips.chain([lo, hi]).map(|p| (p[a], p[b]))
+    }));
     let mut legend = Vec::new();
     for (k, s) in series.iter().enumerate() {
         let n = s.seq.len();
@@ -246,12 +238,10 @@ fn view_panel(
             Swatch::Line(CURVE[k]),
             format!("{} curve", NAME[k]),
         ));
-        let shown = if n > VIEW_DOTS {
-            format!("{} points ({VIEW_DOTS} of {n} shown)", NAME[k])
-        } else {
-            format!("{} points ({n})", NAME[k])
-        };
-        legend.push(LegendItem::new(Swatch::Dot(DOTS[k]), shown));
+        legend.push(LegendItem::new(
+            Swatch::Dot(DOTS[k]),
+            count_label(&format!("{} points", NAME[k]), n.min(VIEW_DOTS), n),
+        ));
     }
     legend.push(LegendItem::new(
         Swatch::Line(ENVELOPE[0]),
