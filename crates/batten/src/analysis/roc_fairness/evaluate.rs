@@ -286,6 +286,9 @@ pub(crate) fn evaluate_detailed(
 /// Option errors ([`Error::InvalidParameter`]), the interpolation's errors for a point design,
 /// [`Error::InvalidParameter`] for a rational curve with unequal weights, and
 /// [`Error::Degenerate`] for a curve of zero length or with a zero-speed sample.
+///
+/// [`Error::InvalidParameter`]: crate::error::Error::InvalidParameter
+/// [`Error::Degenerate`]: crate::error::Error::Degenerate
 pub fn evaluate<'a>(design: impl Into<Design<'a>>, opts: &KuraganoOptions) -> Result<Evaluation> {
     evaluate_detailed(design.into(), opts, None).map(|d| d.evaluation)
 }

@@ -191,6 +191,8 @@ fn resample(curve: &BSplineCurve, like: &RhoSamples) -> Result<RhoSamples> {
 /// [`Error::InvalidParameter`] for a rational curve with unequal weights or a target whose
 /// sign is not σ at some sample, [`Error::TooFewPoints`] when `fix_ends` leaves nothing to
 /// move, and [`Error::Degenerate`] when the curve collapses.
+///
+/// [`sample_rho`]: super::sample_rho
 pub fn modify_shape(
     curve: &BSplineCurve,
     start: &RhoSamples,

@@ -11,6 +11,8 @@ use crate::error::{Error, Result};
 /// interpolant's parameter advances by one per point, so `|dR/du|` is about one chord; the
 /// paper's default of one third ([`quintic::DEFAULT_GRADIENT_FRACTION`]) slows the curve
 /// down near its ends and puts curvature peaks there.
+///
+/// [`quintic::DEFAULT_GRADIENT_FRACTION`]: crate::spline::quintic::DEFAULT_GRADIENT_FRACTION
 pub const DEFAULT_METHOD_GRADIENT_FRACTION: f64 = 1.0;
 
 /// Which residual the shape modification minimises (spec §5.5).
@@ -27,6 +29,8 @@ pub enum Residual {
 
 /// The end conditions of the designed curve when [`evaluate`] or the method starts from
 /// points.
+///
+/// [`evaluate`]: super::evaluate
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub enum DesignEnds {
@@ -34,6 +38,8 @@ pub enum DesignEnds {
     Natural,
     /// Gradients at point indices `0, 1, m−2, m−1` estimated by
     /// [`quintic::end_gradients`] with this fraction of the end chord as magnitude.
+    ///
+    /// [`quintic::end_gradients`]: crate::spline::quintic::end_gradients
     Gradients {
         /// Magnitude of each gradient relative to the end chord.
         fraction: f64,
@@ -47,10 +53,14 @@ pub struct KuraganoOptions {
     /// Number of ρ samples `N_s`, in [`MIN_SAMPLES`]`..=`[`MAX_SAMPLES`]; `None`: [`default_samples`].
     ///
     /// Default value: `None`.
+    ///
+    /// [`default_samples`]: super::default_samples
     pub samples: Option<usize>,
     /// The cap `ρ_max` in data units; `None`: [`DEFAULT_RHO_MAX_REL`] times the arc length.
     ///
     /// Default value: `None`.
+    ///
+    /// [`DEFAULT_RHO_MAX_REL`]: super::DEFAULT_RHO_MAX_REL
     pub rho_max: Option<f64>,
     /// The residual of the shape modification.
     ///

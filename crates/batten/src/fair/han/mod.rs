@@ -114,6 +114,9 @@
 //!
 //! `docs/algorithms/han.md` gives the formulas with the paper's equation numbers and maps the
 //! spec sections cited here to its own.
+//!
+//! [`ZERO_REL`]: crate::analysis::ZERO_REL
+//! [`CubicSplineFn`]: crate::spline::CubicSplineFn
 
 mod params;
 mod partition;

@@ -318,6 +318,8 @@ impl Segment {
     /// near them. The check is local (a few points either side of a move) and, the cubic
     /// being invariant under rigid motion, the same in the segment's frame as in the
     /// plane. `Han` turns it on unless [`FairOptions::keep_clean`] is false.
+    ///
+    /// [`FairOptions::keep_clean`]: crate::fair::FairOptions::keep_clean
     pub fn with_keep_clean(mut self, keep: bool) -> Segment {
         self.keep_clean = keep;
         self

@@ -108,6 +108,8 @@ pub const HERMITE_PARAMS: &[ParamSpec] = &[THRESHOLD_PARAM, EPSILON_PARAM];
 /// The data errors of [`hermite_step`]; [`Error::UnknownOption`] or
 /// [`Error::InvalidParameter`] for bad options; for [`KpRule::Kjellander`], parameter steps
 /// that are not 1.
+///
+/// [`hermite_step`]: super::hermite_step
 pub fn fair_hermite(
     rule: KpRule,
     t: &[f64],

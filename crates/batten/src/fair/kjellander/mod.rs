@@ -103,6 +103,8 @@
 //!
 //! `docs/algorithms/kjellander-poliakoff.md` gives the formulas with the paper's equation
 //! numbers and maps the spec sections cited here to its own.
+//!
+//! [`ParametricCubic::closed`]: crate::spline::ParametricCubic::closed
 
 mod driver;
 mod hermite;

@@ -87,6 +87,7 @@
 //! maps the spec sections cited here to its own.
 //!
 //! [`DEFAULT_TOLERANCE_REL`]: crate::fair::local::DEFAULT_TOLERANCE_REL
+//! [`Error::Degenerate`]: crate::error::Error::Degenerate
 
 mod curve;
 mod params;

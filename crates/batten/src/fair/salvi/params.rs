@@ -16,6 +16,8 @@ pub const DEFAULT_WINDOW: usize = 50;
 pub const WINDOW_MIN_REL_IMPROVEMENT: f64 = 1e-3;
 
 /// Parameters of [`fair_curve`]. Start from [`SalviParams::DEFAULT`].
+///
+/// [`fair_curve`]: super::fair_curve
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct SalviParams {
@@ -35,6 +37,8 @@ pub struct SalviParams {
     /// [`local::DEFAULT_TOLERANCE_REL`] × the bounding-box diagonal of the control points.
     ///
     /// Default value: `None`.
+    ///
+    /// [`local::DEFAULT_TOLERANCE_REL`]: crate::fair::local::DEFAULT_TOLERANCE_REL
     pub tolerance: Option<f64>,
     /// Length R of the recently-moved list.
     ///
@@ -67,6 +71,8 @@ pub struct SalviParams {
     /// literally (see the module documentation).
     ///
     /// Default value: `true`.
+    ///
+    /// [`STALL_REL_IMPROVEMENT`]: super::STALL_REL_IMPROVEMENT
     pub skip_stalled: bool,
 }
 
