@@ -2,12 +2,12 @@
 //! kept, no re-interpolation, the `energy` rule carrying the tangent change `η*`
 //! (`docs/algorithms/kjellander-poliakoff.md`, "Hermite data").
 
-use super::driver::{
-    LocalProblem, MIN_CHORD_REL, MaxTree, TOLERANCE_MARGIN, drive, driven_parameters, max_fraction,
-};
-use super::params::{EPSILON_PARAM, THRESHOLD_PARAM, Threshold, move_limit};
 use super::rules::{KpRule, Local, check_hermite, check_unit_steps};
 use crate::error::{Error, Result};
+use crate::fair::engine::{
+    EPSILON_PARAM, LocalProblem, MIN_CHORD_REL, MaxTree, THRESHOLD_PARAM, Threshold, drive,
+    driven_parameters, move_limit, step_fraction,
+};
 use crate::fair::{FairOptions, Outcome, ParamSpec};
 use crate::geom::{BBox, Point, Vec2};
 
@@ -59,14 +59,7 @@ impl LocalProblem for HermiteState {
         if !(delta.is_finite() && eta.is_finite()) {
             return None;
         }
-        let s = match tolerance {
-            None => 1.0,
-            Some(tol) => max_fraction(
-                self.r[k] - self.origin[k],
-                delta,
-                tol * (1.0 - TOLERANCE_MARGIN),
-            ),
-        };
+        let s = step_fraction(self.r[k] - self.origin[k], delta, tolerance);
         let new = self.r[k] + delta * s;
         if (new - self.r[k - 1]).length() < self.min_chord
             || (self.r[k + 1] - new).length() < self.min_chord

@@ -95,8 +95,7 @@
 //! # Files
 //!
 //! - `rules.rs`: the jump and the three rules at one point (spec §2.2–§2.5);
-//! - `params.rs`: ε, the move limit and the `--set` tables;
-//! - `driver.rs`: the greedy driver shared with `sapidis-farin` (spec §2.6);
+//! - `params.rs`: the `--set` tables beyond ε;
 //! - `points.rs`: point-only fairing of a point sequence (windowed re-solves);
 //! - `hermite.rs`: fairing of Hermite data;
 //! - this file: the three registered methods.
@@ -106,7 +105,6 @@
 //!
 //! [`ParametricCubic::closed`]: crate::spline::ParametricCubic::closed
 
-mod driver;
 mod hermite;
 mod params;
 mod points;
@@ -116,17 +114,18 @@ use super::{FairMethod, FairOptions, Outcome, ParamSpec};
 use crate::error::Result;
 use crate::geom::PointSeq;
 
-pub(super) use driver::{LocalProblem, MaxTree, drive, driven_parameters, max_fraction};
-pub use driver::{MIN_CHORD_REL, MIN_STEP_FRACTION, RETRY_CHANGE_REL, TOLERANCE_MARGIN};
+use super::engine::{EPSILON_PARAM, THRESHOLD_PARAM};
+// The engine's constants, at the paths they had when the engine lived here.
+pub use super::engine::{
+    DEFAULT_MOVES_PER_POINT, DEFAULT_THRESHOLD, JUMP_ZERO_REL, MIN_CHORD_REL, MIN_STEP_FRACTION,
+    RETRY_CHANGE_REL, TOLERANCE_MARGIN,
+};
 pub use hermite::{HERMITE_PARAMS, fair_hermite};
-pub use params::{DEFAULT_MOVES_PER_POINT, DEFAULT_THRESHOLD};
-pub(super) use params::{EPSILON_PARAM, THRESHOLD_PARAM, Threshold, move_limit};
 use params::{MODE_PARAM, REPARAMETRIZE_PARAM, energy_rule, point_params};
 pub use points::SOLVE_HALF_WIDTH;
 use points::run_points;
 pub use rules::{
-    HermiteMove, JUMP_ZERO_REL, KpRule, UNIT_STEP_REL, energy_change_f, hermite_step,
-    parametric_energy,
+    HermiteMove, KpRule, UNIT_STEP_REL, energy_change_f, hermite_step, parametric_energy,
 };
 
 /// Method `kjellander`: uniform parametric cubic, the bad point moved by eq 4 (see the module

@@ -5,12 +5,12 @@
 
 use serde_json::json;
 
-use super::driver::{
-    LocalProblem, MIN_CHORD_REL, MaxTree, TOLERANCE_MARGIN, drive, driven_parameters, max_fraction,
-};
-use super::params::{move_limit, point_params};
+use super::params::point_params;
 use super::rules::{KpRule, Local};
 use crate::error::{Error, Result};
+use crate::fair::engine::{
+    LocalProblem, MIN_CHORD_REL, MaxTree, drive, driven_parameters, move_limit, step_fraction,
+};
 use crate::fair::{FairOptions, Outcome};
 use crate::geom::{BBox, Point, PointSeq, Vec2};
 use crate::numeric::{solve_cyclic_tridiagonal, solve_tridiagonal};
@@ -239,14 +239,7 @@ impl LocalProblem for SplineState {
         if !delta.is_finite() {
             return None;
         }
-        let s = match tolerance {
-            None => 1.0,
-            Some(tol) => max_fraction(
-                self.r[k] - self.origin[k],
-                delta,
-                tol * (1.0 - TOLERANCE_MARGIN),
-            ),
-        };
+        let s = step_fraction(self.r[k] - self.origin[k], delta, tolerance);
         let new = self.r[k] + delta * s;
         let (p, q) = (self.prev(k), self.next(k));
         if (new - self.r[p]).length() < self.min_chord

@@ -6,13 +6,9 @@
 //! §2.2–§2.5).
 
 use crate::error::{Error, Result};
+use crate::fair::engine::JUMP_ZERO_REL;
 use crate::geom::{Point, Vec2};
 use crate::spline::ParametricCubic;
-
-/// A jump no larger than this fraction of the terms it is computed from is rounding noise
-/// and counts as zero (so exactly fair data, e.g. equally spaced collinear points, is left
-/// alone instead of being "faired" at the level of rounding errors).
-pub const JUMP_ZERO_REL: f64 = 1e-12;
 
 /// Kjellander's rule (eq 4) needs unit parameter steps; steps within this relative distance
 /// of 1 count as unit steps.

@@ -14,7 +14,7 @@ use crate::fair::local::{
     self, LocalReport, RecentList, RunningMax, clamp_point, movable_mask, resolve_tolerance,
     select_candidate, support_ranges, uniform_samples,
 };
-use crate::fair::{FairStatus, HistoryRow, Move};
+use crate::fair::{HistoryRow, Move};
 use crate::geom::{Point, Vec2};
 use crate::numeric::{NelderMeadParams, minimize_nelder_mead};
 use crate::spline::{BSplineCurve, MAX_ORDER};
@@ -397,15 +397,7 @@ impl Search {
             cur,
             ..
         } = self;
-        let status = if moves.is_empty() {
-            FairStatus::NoChange
-        } else if !stopped {
-            FairStatus::IterationLimit
-        } else if clamped_moves > 0 {
-            FairStatus::ToleranceLimited
-        } else {
-            FairStatus::Converged
-        };
+        let status = LocalReport::status_of(!moves.is_empty(), stopped, clamped_moves);
         let measure_after: f64 = s.contrib.iter().sum();
         let curvature_after = s
             .hom

@@ -93,9 +93,9 @@ mod curve;
 mod params;
 mod target;
 
-use serde_json::{Map, Value};
+use serde_json::Value;
 
-use super::local::{self, LocalReport, json_f64};
+use super::local::{self, json_f64};
 use super::{FairMethod, FairOptions, Outcome, ParamSpec};
 use crate::error::Result;
 use crate::geom::PointSeq;
@@ -185,37 +185,16 @@ fn run_fitted(
     parameters.insert("tabu".into(), params.tabu_length.into());
     parameters.insert("window".into(), params.window.into());
     parameters.insert("max_iterations".into(), params.max_iterations.into());
-    insert_common(&mut parameters, &report.local);
+    local::insert_common(&mut parameters, &report.local);
     parameters.insert(
         "max_curve_deviation".into(),
         json_f64(report.max_curve_deviation),
     );
-    let mut notes = fitted.notes;
-    notes.extend(report.local.notes);
-    Ok(Outcome {
-        solver: None,
+    Ok(report.local.into_outcome(
         points,
-        status: report.local.status,
-        iterations: report.local.iterations,
-        moves: report.local.moves,
-        history: report.local.history,
         parameters,
-        notes,
-        curve: Some(faired),
-        tangents: None,
-        // Held end control points are the clamped curve's end points.
-        ends_held: (!params.free_ends).then_some(super::EndFix::Position),
-    })
-}
-
-/// Copy the common numbers of a [`LocalReport`] into the report parameters.
-pub(crate) fn insert_common(parameters: &mut Map<String, Value>, r: &LocalReport) {
-    parameters.insert("measure_before".into(), json_f64(r.measure_before));
-    parameters.insert("measure_after".into(), json_f64(r.measure_after));
-    parameters.insert("accepted_moves".into(), r.accepted_moves.into());
-    parameters.insert("clamped_moves".into(), r.clamped_moves.into());
-    parameters.insert(
-        "max_control_displacement".into(),
-        json_f64(r.max_control_displacement),
-    );
+        fitted.notes,
+        Some(faired),
+        params.free_ends,
+    ))
 }

@@ -1,15 +1,21 @@
-//! The greedy driver shared by the KP methods and `sapidis-farin`: move the worst slot (a point
-//! or a knot) until every badness is at most ε, within the tolerance
+//! The greedy move engine: move the worst slot (a point or a knot) until every badness is at
+//! most ε, the move limit is reached, or no bad slot can move within the tolerance; the
+//! max-tree that keeps the worst slot, the stopping threshold ε and the move limit
 //! (`docs/algorithms/kjellander-poliakoff.md`, "The algorithm", spec §2.6, and "What
-//! `sapidis-farin` borrows"). Also the max-tree that keeps the worst slot and the tolerance
-//! clamp of a move.
+//! `sapidis-farin` borrows").
 
 use serde_json::{Map, Value, json};
 
-use super::params::Threshold;
 use crate::error::{Error, Result};
-use crate::fair::{FairStatus, HistoryRow, Move};
-use crate::geom::Vec2;
+use crate::fair::{FairOptions, FairStatus, HistoryRow, Move, ParamSpec};
+
+/// Default relative stopping threshold: the run stops when every `|J_k|` is at most this
+/// fraction of the largest jump of the input.
+pub const DEFAULT_THRESHOLD: f64 = 1e-3;
+
+/// Default iteration limit, per candidate point (bad points for `kjellander`, `poliakoff`
+/// and `energy`; interior knots for `sapidis-farin`): one iteration is one move.
+pub const DEFAULT_MOVES_PER_POINT: usize = 10;
 
 /// A move that the tolerance cuts to less than this fraction of its full length cannot help;
 /// the point is skipped and the next-worst point tried.
@@ -20,25 +26,68 @@ pub const MIN_STEP_FRACTION: f64 = 1e-2;
 /// changes, such as the far tail of a windowed re-solve, leave it skipped.
 pub const RETRY_CHANGE_REL: f64 = 1e-6;
 
-/// Relative margin kept inside the tolerance when a move is scaled back onto it, so that
-/// rounding cannot put a point beyond the tolerance.
-pub const TOLERANCE_MARGIN: f64 = 1e-9;
+/// A jump no larger than this fraction of the terms it is computed from is rounding noise
+/// and counts as zero (so exactly fair data, e.g. equally spaced collinear points, is left
+/// alone instead of being "faired" at the level of rounding errors).
+pub const JUMP_ZERO_REL: f64 = 1e-12;
 
-/// A move that would leave a chord to a neighbour shorter than this fraction of the data's
-/// size (its bounding-box diagonal) is refused: coincident consecutive points have no
-/// chord-length parameter.
-pub const MIN_CHORD_REL: f64 = 1e-9;
+/// The stopping threshold ε: relative to the input's largest badness, or absolute.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Threshold {
+    /// ε = factor × the largest badness of the input.
+    Relative(f64),
+    /// ε in the units of the badness measure.
+    Absolute(f64),
+}
+
+impl Threshold {
+    /// Read the `threshold` and `epsilon` method parameters (`epsilon=auto`, the documented
+    /// default, is the same as leaving it out).
+    pub(crate) fn from_options(options: &FairOptions) -> Result<Threshold> {
+        let rel = options.param_f64_in("threshold", DEFAULT_THRESHOLD, 0.0, 1.0)?;
+        if options.param_is_auto("epsilon") {
+            return Ok(Threshold::Relative(rel));
+        }
+        match options.param_f64("epsilon")? {
+            Some(e) if e < 0.0 => Err(Error::InvalidParameter {
+                name: "epsilon".into(),
+                reason: format!("must be non-negative, got {e}"),
+            }),
+            Some(e) => Ok(Threshold::Absolute(e)),
+            None => Ok(Threshold::Relative(rel)),
+        }
+    }
+}
+
+/// Parameter specs shared by every method that runs on the engine.
+pub(crate) const THRESHOLD_PARAM: ParamSpec = ParamSpec {
+    name: "threshold",
+    default: "0.001",
+    doc: "stop when every third-derivative jump is at most this fraction of the input's largest",
+};
+
+/// See [`THRESHOLD_PARAM`].
+pub(crate) const EPSILON_PARAM: ParamSpec = ParamSpec {
+    name: "epsilon",
+    default: "auto",
+    doc: "absolute stopping bound on the jumps (overrides threshold); auto = threshold x input max",
+};
+
+/// The iteration limit: `max_iterations`, or [`DEFAULT_MOVES_PER_POINT`] per candidate.
+pub(crate) fn move_limit(options: &FairOptions, candidates: usize) -> usize {
+    options.iterations_or(DEFAULT_MOVES_PER_POINT.saturating_mul(candidates.max(1)))
+}
 
 /// A max-heap over slots with O(log n) updates: a tournament tree of `(value, slot)`.
 /// Absent and blocked slots hold −∞.
 #[derive(Clone, Debug)]
-pub(in crate::fair) struct MaxTree {
+pub(crate) struct MaxTree {
     size: usize,
     node: Vec<(f64, usize)>,
 }
 
 impl MaxTree {
-    pub(in crate::fair) fn new(n: usize) -> MaxTree {
+    pub(crate) fn new(n: usize) -> MaxTree {
         let size = n.next_power_of_two().max(1);
         let mut node = vec![(f64::NEG_INFINITY, usize::MAX); 2 * size];
         for (i, leaf) in node[size..size + n].iter_mut().enumerate() {
@@ -51,13 +100,13 @@ impl MaxTree {
     }
 
     /// A tree of `n` slots all holding 0 (built in O(n)).
-    pub(in crate::fair) fn zeros(n: usize) -> MaxTree {
+    pub(crate) fn zeros(n: usize) -> MaxTree {
         let mut t = MaxTree::new(n);
         t.set_runs((0..n).map(|i| (i, 0.0)));
         t
     }
 
-    pub(in crate::fair) fn set(&mut self, i: usize, v: f64) {
+    pub(crate) fn set(&mut self, i: usize, v: f64) {
         self.set_leaf(i, v);
         self.refresh(i, i);
     }
@@ -100,18 +149,18 @@ impl MaxTree {
     }
 
     /// The largest value and its slot, or `None` when every slot is absent.
-    pub(in crate::fair) fn max(&self) -> Option<(usize, f64)> {
+    pub(crate) fn max(&self) -> Option<(usize, f64)> {
         let (v, i) = self.node[1];
         (v > f64::NEG_INFINITY).then_some((i, v))
     }
 
     /// The value at slot `i`.
-    pub(in crate::fair) fn get(&self, i: usize) -> f64 {
+    pub(crate) fn get(&self, i: usize) -> f64 {
         self.node[self.size + i].0
     }
 
     /// The largest value, 0 when every slot is absent.
-    pub(in crate::fair) fn max_value(&self) -> f64 {
+    pub(crate) fn max_value(&self) -> f64 {
         self.max().map_or(0.0, |(_, v)| v)
     }
 }
@@ -122,36 +171,9 @@ fn better(l: (f64, usize), r: (f64, usize)) -> (f64, usize) {
     if r.0 > l.0 { r } else { l }
 }
 
-/// The largest `s ∈ [0, 1]` with `|e + s·w| ≤ radius`, given `|e| ≤ radius` (the point's
-/// current offset `e` from its original position, the move `w`).
-pub(in crate::fair) fn max_fraction(e: Vec2, w: Vec2, radius: f64) -> f64 {
-    let ww = w.length_squared();
-    if ww == 0.0 {
-        return 1.0;
-    }
-    let slack = radius * radius - e.length_squared();
-    if slack <= 0.0 {
-        // On (or beyond) the bound: only inward moves are allowed, and they end on it again.
-        return if e.dot(w) < 0.0 {
-            (-2.0 * e.dot(w) / ww).min(1.0)
-        } else {
-            0.0
-        };
-    }
-    let b = e.dot(w);
-    let root = (b * b + ww * slack).sqrt();
-    // Positive root of ww s² + 2 b s − slack = 0, in the cancellation-free form.
-    let s = if b > 0.0 {
-        slack / (b + root)
-    } else {
-        (root - b) / ww
-    };
-    s.clamp(0.0, 1.0)
-}
-
 /// A local fairing problem for [`drive`]: slots (points or knots) with a badness, and moves
 /// that change the badness of a few slots.
-pub(in crate::fair) trait LocalProblem {
+pub(crate) trait LocalProblem {
     /// Number of slots.
     fn slots(&self) -> usize;
     /// Whether slot `i` may be chosen as the bad one.
@@ -182,13 +204,13 @@ pub(in crate::fair) trait LocalProblem {
 
 /// What [`drive`] did.
 #[derive(Clone, Debug)]
-pub(in crate::fair) struct Driven {
-    pub(in crate::fair) status: FairStatus,
-    pub(in crate::fair) moves: Vec<Move>,
-    pub(in crate::fair) history: Vec<HistoryRow>,
-    pub(in crate::fair) notes: Vec<String>,
-    pub(in crate::fair) epsilon: f64,
-    pub(in crate::fair) initial_max: f64,
+pub(crate) struct Driven {
+    pub(crate) status: FairStatus,
+    pub(crate) moves: Vec<Move>,
+    pub(crate) history: Vec<HistoryRow>,
+    pub(crate) notes: Vec<String>,
+    pub(crate) epsilon: f64,
+    pub(crate) initial_max: f64,
 }
 
 fn checked_badness(p: &impl LocalProblem, i: usize) -> Result<f64> {
@@ -204,7 +226,7 @@ fn checked_badness(p: &impl LocalProblem, i: usize) -> Result<f64> {
 
 /// The greedy loop of spec §2.6: move the worst slot until every badness is at most ε, the
 /// move limit is reached, or no bad slot can move within the tolerance.
-pub(in crate::fair) fn drive(
+pub(crate) fn drive(
     p: &mut impl LocalProblem,
     threshold: Threshold,
     max_moves: usize,
@@ -357,7 +379,7 @@ impl Tally {
 }
 
 /// The common part of the reported parameters.
-pub(in crate::fair) fn driven_parameters(
+pub(crate) fn driven_parameters(
     d: &Driven,
     threshold: Threshold,
     max_moves: usize,
@@ -413,19 +435,5 @@ mod tests {
             assert_eq!(x, best);
             assert_eq!(v[i], best);
         }
-    }
-
-    #[test]
-    fn max_fraction_stops_on_the_bound() {
-        let e = Vec2::new(0.5, 0.0);
-        let w = Vec2::new(1.0, 0.0);
-        assert!((max_fraction(e, w, 1.0) - 0.5).abs() < 1e-15);
-        assert_eq!(max_fraction(Vec2::ZERO, w, 2.0), 1.0);
-        // On the bound, outward: nothing; inward: up to the far side.
-        assert_eq!(max_fraction(Vec2::new(1.0, 0.0), w, 1.0), 0.0);
-        assert_eq!(max_fraction(Vec2::new(1.0, 0.0), -w, 1.0), 1.0);
-        let s = max_fraction(Vec2::new(0.3, 0.4), Vec2::new(-3.0, 1.0), 0.6);
-        let end = Vec2::new(0.3, 0.4) + Vec2::new(-3.0, 1.0) * s;
-        assert!((end.length() - 0.6).abs() < 1e-14);
     }
 }
