@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::anyhow;
-use batten::fair::kuragano::{
+use batten::analysis::roc_fairness::{
     self, DEFAULT_METHOD_GRADIENT_FRACTION, DesignEnds, Evaluation, KuraganoOptions, Residual,
 };
 use batten::io;
@@ -98,14 +98,14 @@ pub fn run(args: &EvaluateArgs) -> Result<ExitCode, Failure> {
         crate::formats::read_input(&args.input, format, false, &io::Pick::default())?.source;
     let evaluation = match source {
         io::Source::Space(_) => return Err(crate::input::space_not_planar(&args.input)),
-        io::Source::Curve(c) => kuragano::evaluate(&c, &opts),
+        io::Source::Curve(c) => roc_fairness::evaluate(&c, &opts),
         io::Source::Points(data) => {
             if data.seq.is_closed() {
                 return Err(Failure::usage(anyhow!(
                     "{name}: the fairness evaluation needs an open curve"
                 )));
             }
-            kuragano::evaluate(data.seq.points(), &opts)
+            roc_fairness::evaluate(data.seq.points(), &opts)
         }
     }
     .map_err(|e| Failure::from_batten(&what, e))?;
@@ -139,7 +139,10 @@ fn table(name: &str, e: &Evaluation) -> String {
         let (cos, short, full) = match (d.correlation, d.angle_deg) {
             (Some(c), Some(a)) => (
                 format!("{c:.COSINE_DECIMALS$}"),
-                format!("{:.2}", kuragano::truncate_angle(a, PAPER_ANGLE_DECIMALS)),
+                format!(
+                    "{:.2}",
+                    roc_fairness::truncate_angle(a, PAPER_ANGLE_DECIMALS)
+                ),
                 format!("{a:.10}"),
             ),
             _ => ("-".to_string(), "-".to_string(), "-".to_string()),
@@ -164,12 +167,12 @@ fn table(name: &str, e: &Evaluation) -> String {
                 .filter_map(|r| r.correlation)
                 .fold(f64::NEG_INFINITY, f64::max);
             if max > f {
-                // A tie (kuragano::TIE_TOLERANCE) went to the lower degree: say so.
+                // A tie (roc_fairness::TIE_TOLERANCE) went to the lower degree: say so.
                 let _ = write!(
                     s,
                     " (the lowest degree within {:e} of the largest correlation, \
                      {max:.COSINE_DECIMALS$})",
-                    kuragano::TIE_TOLERANCE
+                    roc_fairness::TIE_TOLERANCE
                 );
             }
             let _ = writeln!(s);
@@ -188,7 +191,7 @@ fn table(name: &str, e: &Evaluation) -> String {
 #[cfg(test)]
 #[allow(clippy::unwrap_used)]
 mod tests {
-    use batten::fair::kuragano::DegreeResult;
+    use batten::analysis::roc_fairness::DegreeResult;
 
     use super::*;
 
@@ -197,7 +200,7 @@ mod tests {
             degree,
             applicable: cos.is_some(),
             correlation: cos,
-            angle_deg: cos.map(kuragano::angle_degrees),
+            angle_deg: cos.map(roc_fairness::angle_degrees),
             s_final: None,
             rho_rms: None,
         }

@@ -1,6 +1,7 @@
 //! Measurements of curves: signed curvature and its arc-length derivative, radius of
 //! curvature, arc length, energies, inflections, curvature extrema, curvature-comb samples,
-//! Calì's fairness indicators, and the [`FairnessMetrics`] every report carries.
+//! Calì's fairness indicators, the [`FairnessMetrics`] every report carries, and Kuragano &
+//! Yamaguchi's radius-of-curvature fairness evaluation ([`roc_fairness`]).
 //!
 //! Everything is generic over the capability traits in [`crate::curve`].
 
@@ -9,6 +10,7 @@ mod curvature;
 mod gfi;
 mod metrics;
 mod noise;
+pub mod roc_fairness;
 mod space;
 mod space_curve;
 

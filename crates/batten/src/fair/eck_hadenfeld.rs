@@ -51,9 +51,8 @@ use super::local::{
     self, DEFAULT_TABU_LENGTH, FIT_PARAMS, LocalReport, RecentList, RunningMax, clamp_point,
     movable_mask, resolve_tolerance, select_candidate,
 };
-use super::salvi::insert_common;
-use super::sapidis_farin::{PAD, interpolate_closed, period_index};
-use super::{FairMethod, FairOptions, FairStatus, HistoryRow, Move, Outcome, ParamSpec};
+use super::periodic::{PAD, interpolate_closed, period_index};
+use super::{FairMethod, FairOptions, HistoryRow, Move, Outcome, ParamSpec};
 use crate::curve::Curve;
 use crate::error::{Error, Result};
 use crate::geom::{Point, PointSeq, Vec2};
@@ -554,15 +553,7 @@ fn fair_control_points(
         });
     }
     let measure_after = gram.energy(&d);
-    let status = if moves.is_empty() {
-        FairStatus::NoChange
-    } else if !converged {
-        FairStatus::IterationLimit
-    } else if clamped_moves > 0 {
-        FairStatus::ToleranceLimited
-    } else {
-        FairStatus::Converged
-    };
+    let status = LocalReport::status_of(!moves.is_empty(), converged, clamped_moves);
     let mut notes = Vec::new();
     if clamped_moves > 0 {
         notes.push(format!(
@@ -696,28 +687,14 @@ fn outcome(
     report: LocalReport,
     params: &EckHadenfeldParams,
     mut parameters: serde_json::Map<String, Value>,
-    mut notes: Vec<String>,
+    notes: Vec<String>,
     curve: Option<BSplineCurve>,
 ) -> Outcome {
     parameters.insert("order".into(), Value::from(params.order));
     parameters.insert("tabu".into(), params.tabu_length.into());
     parameters.insert("max_iterations".into(), params.max_iterations.into());
-    insert_common(&mut parameters, &report);
-    notes.extend(report.notes);
-    Outcome {
-        solver: None,
-        points,
-        status: report.status,
-        iterations: report.iterations,
-        moves: report.moves,
-        history: report.history,
-        parameters,
-        notes,
-        curve,
-        tangents: None,
-        // Held end control points are the clamped curve's end points.
-        ends_held: (!params.free_ends).then_some(super::EndFix::Position),
-    }
+    local::insert_common(&mut parameters, &report);
+    report.into_outcome(points, parameters, notes, curve, params.free_ends)
 }
 
 /// The method on a closed curve: the periodic cubic through the points (the wrapped form

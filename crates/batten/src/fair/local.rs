@@ -327,6 +327,52 @@ pub struct LocalReport {
     pub notes: Vec<String>,
 }
 
+impl LocalReport {
+    /// How a run of a local method ended: `no_change` when it accepted no move,
+    /// `iteration_limit` when no stopping rule ended it (`stopped` false), `tolerance_limited`
+    /// when the clamp shortened an accepted move, else `converged`.
+    pub(crate) fn status_of(moved: bool, stopped: bool, clamped_moves: usize) -> FairStatus {
+        if !moved {
+            FairStatus::NoChange
+        } else if !stopped {
+            FairStatus::IterationLimit
+        } else if clamped_moves > 0 {
+            FairStatus::ToleranceLimited
+        } else {
+            FairStatus::Converged
+        }
+    }
+
+    /// The method's [`Outcome`] from this report: the output `points`, the report's
+    /// `parameters` and the `notes` so far (the run's own notes follow them) and the faired
+    /// `curve`. Unless `free_ends`, the end control points were held, and they are the clamped
+    /// curve's end points.
+    pub(crate) fn into_outcome(
+        self,
+        points: Vec<Point>,
+        parameters: serde_json::Map<String, serde_json::Value>,
+        mut notes: Vec<String>,
+        curve: Option<BSplineCurve>,
+        free_ends: bool,
+    ) -> Outcome {
+        notes.extend(self.notes);
+        Outcome {
+            solver: None,
+            points,
+            status: self.status,
+            iterations: self.iterations,
+            moves: self.moves,
+            history: self.history,
+            parameters,
+            notes,
+            curve,
+            tangents: None,
+            // Held end control points are the clamped curve's end points.
+            ends_held: (!free_ends).then_some(super::EndFix::Position),
+        }
+    }
+}
+
 /// The largest of a set of per-index values under point updates, with the maximum recomputed
 /// only when the current maximum decreases.
 #[derive(Clone, Debug)]
@@ -634,6 +680,21 @@ pub(crate) fn output_points(
         out[n - 1] = pts[n - 1];
     }
     out
+}
+
+/// Copy the common numbers of a [`LocalReport`] into the report parameters.
+pub(crate) fn insert_common(
+    parameters: &mut serde_json::Map<String, serde_json::Value>,
+    r: &LocalReport,
+) {
+    parameters.insert("measure_before".into(), json_f64(r.measure_before));
+    parameters.insert("measure_after".into(), json_f64(r.measure_after));
+    parameters.insert("accepted_moves".into(), r.accepted_moves.into());
+    parameters.insert("clamped_moves".into(), r.clamped_moves.into());
+    parameters.insert(
+        "max_control_displacement".into(),
+        json_f64(r.max_control_displacement),
+    );
 }
 
 /// A float as a JSON value (`null` when not finite).

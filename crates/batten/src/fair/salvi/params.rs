@@ -1,0 +1,238 @@
+//! The parameters of `salvi`: [`SalviParams`] with their defaults, the `--set` table and its
+//! parsing (`docs/algorithms/salvi-varady.md`, "Parameters").
+
+use super::target::{DEFAULT_PASSES, MAX_SAMPLES, MIN_SAMPLES, MIN_TARGET_COEFFICIENTS, Smoother};
+use crate::error::Result;
+use crate::fair::local::{DEFAULT_TABU_LENGTH, FIT_PARAMS};
+use crate::fair::{FairOptions, ParamSpec};
+
+/// Default iteration limit (the paper's Table 1 runs 1000 iterations).
+pub const DEFAULT_MAX_ITERATIONS: usize = 1000;
+
+/// Default window M of the stopping rule.
+pub const DEFAULT_WINDOW: usize = 50;
+
+/// Stop when Ê fell by less than this fraction of its value M iterations earlier.
+pub const WINDOW_MIN_REL_IMPROVEMENT: f64 = 1e-3;
+
+/// Parameters of [`fair_curve`]. Start from [`SalviParams::DEFAULT`].
+///
+/// [`fair_curve`]: super::fair_curve
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct SalviParams {
+    /// Number of samples N, at most [`MAX_SAMPLES`]; `None`: `max(200, 8 × non-empty spans)`.
+    ///
+    /// Default value: `None`.
+    pub samples: Option<usize>,
+    /// How g is made.
+    ///
+    /// Default value: [`Smoother::DEFAULT`].
+    pub smoother: Smoother,
+    /// Make g equal κ at both ends.
+    ///
+    /// Default value: `false`.
+    pub pin_ends: bool,
+    /// δ, the largest distance of a control point from its original position; `None`:
+    /// [`local::DEFAULT_TOLERANCE_REL`] × the bounding-box diagonal of the control points.
+    ///
+    /// Default value: `None`.
+    ///
+    /// [`local::DEFAULT_TOLERANCE_REL`]: crate::fair::local::DEFAULT_TOLERANCE_REL
+    pub tolerance: Option<f64>,
+    /// Length R of the recently-moved list.
+    ///
+    /// Default value: [`DEFAULT_TABU_LENGTH`] (4).
+    pub tabu_length: usize,
+    /// Iteration limit.
+    ///
+    /// Default value: [`DEFAULT_MAX_ITERATIONS`] (1000).
+    pub max_iterations: usize,
+    /// Window M of the stopping rule; 0 disables it (run `max_iterations`).
+    ///
+    /// Default value: [`DEFAULT_WINDOW`] (50).
+    pub window: usize,
+    /// Relative improvement over the window below which the run stops.
+    ///
+    /// Default value: [`WINDOW_MIN_REL_IMPROVEMENT`].
+    pub min_rel_improvement: f64,
+    /// Let the first and last control points move.
+    ///
+    /// Default value: `false`.
+    pub free_ends: bool,
+    /// Control points held at each end unless `free_ends`: 1 (the end points), 2 (also the
+    /// end tangents) or 3 (also the end curvatures); `--fix-ends=tangent` / `curvature`.
+    ///
+    /// Default value: 1.
+    pub held_ends: usize,
+    /// Skip a control point whose last search made no progress (relative local improvement
+    /// below [`STALL_REL_IMPROVEMENT`]) until a control point whose support overlaps its own
+    /// makes progress; stop when every movable point is skipped. `false` follows spec §3 step 5
+    /// literally (see the module documentation).
+    ///
+    /// Default value: `true`.
+    ///
+    /// [`STALL_REL_IMPROVEMENT`]: super::STALL_REL_IMPROVEMENT
+    pub skip_stalled: bool,
+}
+
+impl SalviParams {
+    /// The defaults listed on each field.
+    pub const DEFAULT: SalviParams = SalviParams {
+        samples: None,
+        smoother: Smoother::DEFAULT,
+        pin_ends: false,
+        tolerance: None,
+        tabu_length: DEFAULT_TABU_LENGTH,
+        max_iterations: DEFAULT_MAX_ITERATIONS,
+        window: DEFAULT_WINDOW,
+        min_rel_improvement: WINDOW_MIN_REL_IMPROVEMENT,
+        free_ends: false,
+        held_ends: 1,
+        skip_stalled: true,
+    };
+
+    /// Set δ.
+    pub fn with_tolerance(mut self, delta: f64) -> SalviParams {
+        self.tolerance = Some(delta);
+        self
+    }
+
+    /// Set N.
+    pub fn with_samples(mut self, n: usize) -> SalviParams {
+        self.samples = Some(n);
+        self
+    }
+
+    /// Set the smoother.
+    pub fn with_smoother(mut self, smoother: Smoother) -> SalviParams {
+        self.smoother = smoother;
+        self
+    }
+
+    /// Pin (or not) the target to κ at the ends.
+    pub fn with_pin_ends(mut self, pin: bool) -> SalviParams {
+        self.pin_ends = pin;
+        self
+    }
+
+    /// Set the iteration limit.
+    pub fn with_max_iterations(mut self, n: usize) -> SalviParams {
+        self.max_iterations = n;
+        self
+    }
+
+    /// Set the window M (0: no window rule).
+    pub fn with_window(mut self, m: usize) -> SalviParams {
+        self.window = m;
+        self
+    }
+
+    /// Set the tabu length R.
+    pub fn with_tabu_length(mut self, r: usize) -> SalviParams {
+        self.tabu_length = r;
+        self
+    }
+
+    /// Free (or fix) the end control points.
+    pub fn with_free_ends(mut self, free: bool) -> SalviParams {
+        self.free_ends = free;
+        self
+    }
+
+    /// Hold `k` control points at each end (see [`SalviParams::held_ends`]).
+    pub fn with_held_ends(mut self, k: usize) -> SalviParams {
+        self.held_ends = k;
+        self
+    }
+
+    /// Skip stalled control points (default) or follow the spec's selection literally.
+    pub fn with_skip_stalled(mut self, skip: bool) -> SalviParams {
+        self.skip_stalled = skip;
+        self
+    }
+}
+
+impl Default for SalviParams {
+    fn default() -> SalviParams {
+        SalviParams::DEFAULT
+    }
+}
+
+pub(super) static PARAMS: [ParamSpec; 11] = [
+    ParamSpec {
+        name: "samples",
+        default: "auto",
+        doc: "number of curvature samples N, 4..=20000 (auto: max(200, 8 per knot span))",
+    },
+    ParamSpec {
+        name: "smoother",
+        default: "average",
+        doc: "target curvature: average (moving average) or bspline (least-squares fit of κ(s))",
+    },
+    ParamSpec {
+        name: "half_width",
+        default: "auto",
+        doc: "moving-average half-width in samples (auto: N/20; at most 20000)",
+    },
+    ParamSpec {
+        name: "passes",
+        default: "3",
+        doc: "moving-average passes",
+    },
+    ParamSpec {
+        name: "target_coefficients",
+        default: "auto",
+        doc: "coefficients of the bspline target fit (auto: max(4, N/20); at most 20000)",
+    },
+    ParamSpec {
+        name: "pin_ends",
+        default: "false",
+        doc: "make the target equal the curvature at both ends",
+    },
+    ParamSpec {
+        name: "tabu",
+        default: "4",
+        doc: "length R of the recently-moved list",
+    },
+    ParamSpec {
+        name: "window",
+        default: "50",
+        doc: "stop when the measure improved < 0.1% over this many iterations (0: never; at most 1000000)",
+    },
+    FIT_PARAMS[0],
+    FIT_PARAMS[1],
+    FIT_PARAMS[2],
+];
+
+/// The parameters of a run; `tolerance` (δ) and `free_ends` come from the fitted input. The
+/// smoother parameters are all checked, whichever smoother is chosen.
+pub(super) fn salvi_params(
+    options: &FairOptions,
+    tolerance: Option<f64>,
+    free_ends: bool,
+) -> Result<SalviParams> {
+    let samples = options.param_auto_usize_in("samples", MIN_SAMPLES, MAX_SAMPLES)?;
+    let auto_usize = |key: &str, lo: usize| options.param_auto_usize_in(key, lo, MAX_SAMPLES);
+    let coefficients = auto_usize("target_coefficients", MIN_TARGET_COEFFICIENTS)?;
+    let half_width = auto_usize("half_width", 0)?;
+    let passes = options.param_usize_in("passes", DEFAULT_PASSES, 0, 1000)?;
+    let smoother = match options.param_choice("smoother", "average", &["average", "bspline"])? {
+        "bspline" => Smoother::BSplineFit { coefficients },
+        _ => Smoother::MovingAverage { half_width, passes },
+    };
+    let max_iterations = options.iterations_or(DEFAULT_MAX_ITERATIONS);
+    Ok(SalviParams {
+        samples,
+        smoother,
+        pin_ends: options.param_bool("pin_ends", false)?,
+        tolerance,
+        tabu_length: options.param_usize_in("tabu", DEFAULT_TABU_LENGTH, 0, 1000)?,
+        max_iterations,
+        window: options.param_usize_in("window", DEFAULT_WINDOW, 0, crate::fair::MAX_ITERATIONS)?,
+        min_rel_improvement: WINDOW_MIN_REL_IMPROVEMENT,
+        free_ends,
+        held_ends: options.fix_ends.held().max(1),
+        skip_stalled: true,
+    })
+}
