@@ -1,19 +1,18 @@
 //! `batten compare`: several methods on one input, tabulated like Table 1 of Han et al.
 //! (`Infl_num`, `Vib_num`, `S_d/M_d`, `E_s`), with Calì's GFI and the run time added.
 //!
-//! As in the paper, the smoothing spline `mst` is run at the same largest displacement as the
-//! first method listed: with `tolerance` = that method's `M_d` and no `p`, which makes `mst`
-//! bisect on `p`. When `mst` is listed first it runs with the options given.
+//! The runs are the library's comparison protocol ([`fair::compare`]: as in the paper, the
+//! smoothing spline `mst` at the same largest displacement as the first method listed); this
+//! module resolves `--methods` and formats the rows.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::process::ExitCode;
 
 use anyhow::anyhow;
-use batten::fair::{self, EndFix, FairMethod, FairReport};
+use batten::fair::{self, Comparison, ComparisonOutcome, ComparisonRow, EndFix, FairMethod};
 use batten::io::format_f64;
-use batten::{FairOptions, FairnessMetrics, Point, PointSeq};
-use rayon::prelude::*;
+use batten::{FairOptions, FairReport, FairnessMetrics, PointSeq};
 use serde::Serialize;
 
 use crate::failure::{EXIT_FAILED, Failure};
@@ -21,33 +20,8 @@ use crate::input;
 use crate::output::{self, seconds, sig};
 use crate::{CompareArgs, TableFormat};
 
-/// The method that is run at the displacement of the first one.
-const MST: &str = "mst";
-
 /// Significant digits of real numbers in the Markdown table.
 const DIGITS: usize = 4;
-
-/// How one method's run ended.
-#[derive(Debug)]
-pub(crate) enum Outcome {
-    Ran(Box<FairReport>),
-    Failed(String),
-    /// Not run, and why (e.g. a closed curve for a method that takes only open ones).
-    Skipped(String),
-}
-
-/// One row of the table.
-#[derive(Debug)]
-pub(crate) struct Row {
-    pub(crate) method: &'static str,
-    /// The tolerance the method ran with.
-    tolerance: Option<f64>,
-    /// Why the options differ from the ones given, if they do.
-    note: Option<String>,
-    pub(crate) outcome: Outcome,
-    /// The faired points, when the method ran (`batten report` draws them).
-    pub(crate) points: Option<Vec<Point>>,
-}
 
 /// Run `batten compare`.
 ///
@@ -70,30 +44,34 @@ pub fn run(args: &CompareArgs) -> Result<ExitCode, Failure> {
     let before = FairnessMetrics::of_seq(&data.seq)
         .map_err(|e| Failure::from_batten(&format!("{name}: cannot analyse"), e))?;
 
-    let rows = run_methods(&methods, &data.seq, &base);
+    let comparison = fair::compare(&methods, &data.seq, &base);
+    let rows = &comparison.rows;
     let text = match args.format {
-        TableFormat::Md => markdown(&name, &data.seq, &base, &before, &rows),
-        TableFormat::Csv => csv(&before, &rows),
+        TableFormat::Md => markdown(&name, &data.seq, &base, &before, rows),
+        TableFormat::Csv => csv(&before, rows),
         TableFormat::Json => {
-            let mut s = serde_json::to_string_pretty(&to_json(&name, &base, &before, &rows))
+            let mut s = serde_json::to_string_pretty(&to_json(&name, &base, &before, rows))
                 .map_err(|e| Failure::failed(anyhow!("cannot encode the table: {e}")))?;
             s.push('\n');
             s
         }
     };
     output::stdout(&text)?;
+    Ok(exit_code(&name, &comparison))
+}
+
+/// One error line per method that failed; exit code 1 if one did, else 0.
+pub(crate) fn exit_code(name: &str, comparison: &Comparison) -> ExitCode {
     let mut failed = false;
-    for row in &rows {
-        if let Outcome::Failed(msg) = &row.outcome {
-            output::error_line(&format!("{name}: method {} failed: {msg}", row.method));
-            failed = true;
-        }
+    for (method, e) in comparison.failures() {
+        output::error_line(&format!("{name}: method {method} failed: {e}"));
+        failed = true;
     }
-    Ok(if failed {
+    if failed {
         ExitCode::from(EXIT_FAILED)
     } else {
         ExitCode::SUCCESS
-    })
+    }
 }
 
 /// The methods named (all registered when none), each once.
@@ -115,98 +93,17 @@ pub(crate) fn resolve(names: &[String]) -> Result<Vec<&'static dyn FairMethod>, 
     Ok(out)
 }
 
-/// Run every method (in parallel), `mst` at the first method's displacement.
-pub(crate) fn run_methods(
-    methods: &[&'static dyn FairMethod],
-    seq: &PointSeq,
-    base: &FairOptions,
-) -> Vec<Row> {
-    let Some((&first, rest)) = methods.split_first() else {
-        return Vec::new();
-    };
-    if first.name() == MST || !rest.iter().any(|m| m.name() == MST) {
-        return methods
-            .par_iter()
-            .map(|&m| run_one(m, seq, base.clone(), None))
-            .collect();
-    }
-    let first_row = run_one(first, seq, base.clone(), None);
-    let (mst_options, mst_note) = match &first_row.outcome {
-        Outcome::Ran(r) if r.max_displacement > 0.0 => {
-            let mut o = base.clone();
-            o.tolerance = Some(r.max_displacement);
-            o.params.clear();
-            let note = format!(
-                "run at tolerance {}, the max displacement of {} (as in Han et al.)",
-                sig(r.max_displacement, DIGITS),
-                first.name()
-            );
-            (o, note)
-        }
-        Outcome::Ran(_) => (
-            base.clone(),
-            format!(
-                "{} moved no point, so {MST} ran with the options given",
-                first.name()
-            ),
-        ),
-        _ => (
-            base.clone(),
-            format!(
-                "{} did not run, so {MST} ran with the options given",
-                first.name()
-            ),
-        ),
-    };
-    let mut rows = vec![first_row];
-    rows.par_extend(rest.par_iter().map(|&m| {
-        if m.name() == MST {
-            run_one(m, seq, mst_options.clone(), Some(mst_note.clone()))
-        } else {
-            run_one(m, seq, base.clone(), None)
-        }
-    }));
-    rows
-}
-
-fn run_one(
-    m: &'static dyn FairMethod,
-    seq: &PointSeq,
-    options: FairOptions,
-    note: Option<String>,
-) -> Row {
-    let mut points = None;
-    let outcome = if seq.is_closed() && !m.supports_closed() {
-        Outcome::Skipped("does not support closed curves".to_string())
-    } else {
-        match fair::fair_with(m, seq, &options) {
-            Ok(f) => {
-                points = Some(f.points);
-                Outcome::Ran(Box::new(f.report))
-            }
-            Err(e) => Outcome::Failed(e.to_string()),
-        }
-    };
-    Row {
-        method: m.name(),
-        tolerance: options.tolerance,
-        note,
-        outcome,
-        points,
-    }
-}
-
 /// Remarks under the Markdown table: why options differ, failures, missed tolerances.
-fn remarks(row: &Row) -> Vec<String> {
+fn remarks(row: &ComparisonRow) -> Vec<String> {
     let mut v: Vec<String> = row.note.iter().cloned().collect();
     match &row.outcome {
-        Outcome::Ran(r) if !r.tolerance_met => v.push(format!(
+        ComparisonOutcome::Ran(f) if !f.report.tolerance_met => v.push(format!(
             "tolerance {} not met",
-            r.tolerance.map_or_else(String::new, format_f64)
+            f.report.tolerance.map_or_else(String::new, format_f64)
         )),
-        Outcome::Ran(_) => {}
-        Outcome::Failed(msg) => v.push(format!("failed: {msg}")),
-        Outcome::Skipped(why) => v.push(format!("skipped: {why}")),
+        ComparisonOutcome::Ran(_) => {}
+        ComparisonOutcome::Failed(e) => v.push(format!("failed: {e}")),
+        ComparisonOutcome::Skipped(why) => v.push(format!("skipped: {why}")),
     }
     v
 }
@@ -216,7 +113,7 @@ pub(crate) fn markdown(
     seq: &PointSeq,
     base: &FairOptions,
     before: &FairnessMetrics,
-    rows: &[Row],
+    rows: &[ComparisonRow],
 ) -> String {
     let mut s = format!(
         "{name}: {} points, {}; tolerance {}{}\n\n",
@@ -251,20 +148,27 @@ pub(crate) fn markdown(
             format!(" [{}]", notes.len())
         };
         let _ = match &row.outcome {
-            Outcome::Ran(rep) => writeln!(
-                s,
-                "| {}{mark} | {} | {} | {}/{} | {} | {} | {} |",
-                row.method,
-                rep.after.inflections,
-                rep.after.vibrations,
-                sig(rep.sum_displacement, DIGITS),
-                sig(rep.max_displacement, DIGITS),
-                sig(rep.after.strain_energy, DIGITS),
-                sig(rep.after.gfi, DIGITS),
-                seconds(rep.elapsed_seconds),
-            ),
-            Outcome::Failed(_) => writeln!(s, "| {}{mark} | failed | | | | | |", row.method),
-            Outcome::Skipped(_) => writeln!(s, "| {}{mark} | skipped | | | | | |", row.method),
+            ComparisonOutcome::Ran(f) => {
+                let rep = &f.report;
+                writeln!(
+                    s,
+                    "| {}{mark} | {} | {} | {}/{} | {} | {} | {} |",
+                    row.method,
+                    rep.after.inflections,
+                    rep.after.vibrations,
+                    sig(rep.sum_displacement, DIGITS),
+                    sig(rep.max_displacement, DIGITS),
+                    sig(rep.after.strain_energy, DIGITS),
+                    sig(rep.after.gfi, DIGITS),
+                    seconds(rep.elapsed_seconds),
+                )
+            }
+            ComparisonOutcome::Failed(_) => {
+                writeln!(s, "| {}{mark} | failed | | | | | |", row.method)
+            }
+            ComparisonOutcome::Skipped(_) => {
+                writeln!(s, "| {}{mark} | skipped | | | | | |", row.method)
+            }
         };
     }
     if !notes.is_empty() {
@@ -294,7 +198,7 @@ pub fn csv_num(x: f64) -> String {
     }
 }
 
-fn csv(before: &FairnessMetrics, rows: &[Row]) -> String {
+fn csv(before: &FairnessMetrics, rows: &[ComparisonRow]) -> String {
     let mut s = String::from(
         "method,inflections,vibrations,sum_displacement,max_displacement,strain_energy,gfi,\
          seconds,tolerance,tolerance_met,status,note\n",
@@ -312,27 +216,30 @@ fn csv(before: &FairnessMetrics, rows: &[Row]) -> String {
         let tol = row.tolerance.map(csv_num).unwrap_or_default();
         let note = csv_field(&row.note.clone().unwrap_or_default());
         let _ = match &row.outcome {
-            Outcome::Ran(r) => writeln!(
-                s,
-                "{},{},{},{},{},{},{},{},{tol},{},{},{note}",
-                row.method,
-                r.after.inflections,
-                r.after.vibrations,
-                csv_num(r.sum_displacement),
-                csv_num(r.max_displacement),
-                csv_num(r.after.strain_energy),
-                csv_num(r.after.gfi),
-                csv_num(r.elapsed_seconds),
-                r.tolerance_met,
-                status_name(r),
-            ),
-            Outcome::Failed(msg) => writeln!(
+            ComparisonOutcome::Ran(f) => {
+                let r = &f.report;
+                writeln!(
+                    s,
+                    "{},{},{},{},{},{},{},{},{tol},{},{},{note}",
+                    row.method,
+                    r.after.inflections,
+                    r.after.vibrations,
+                    csv_num(r.sum_displacement),
+                    csv_num(r.max_displacement),
+                    csv_num(r.after.strain_energy),
+                    csv_num(r.after.gfi),
+                    csv_num(r.elapsed_seconds),
+                    r.tolerance_met,
+                    status_name(r),
+                )
+            }
+            ComparisonOutcome::Failed(e) => writeln!(
                 s,
                 "{},,,,,,,,{tol},,failed,{}",
                 row.method,
-                csv_field(&join_note(row.note.as_deref(), msg))
+                csv_field(&join_note(row.note.as_deref(), &e.to_string()))
             ),
-            Outcome::Skipped(why) => writeln!(
+            ComparisonOutcome::Skipped(why) => writeln!(
                 s,
                 "{},,,,,,,,{tol},,skipped,{}",
                 row.method,
@@ -375,7 +282,7 @@ struct RowJson<'a> {
     note: Option<&'a str>,
     status: String,
     #[serde(skip_serializing_if = "Option::is_none")]
-    error: Option<&'a str>,
+    error: Option<String>,
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     result: Option<RunJson<'a>>,
 }
@@ -399,31 +306,34 @@ fn to_json<'a>(
     name: &'a str,
     base: &FairOptions,
     before: &'a FairnessMetrics,
-    rows: &'a [Row],
+    rows: &'a [ComparisonRow],
 ) -> CompareJson<'a> {
     let rows = rows
         .iter()
         .map(|row| {
             let (status, error, result) = match &row.outcome {
-                Outcome::Ran(r) => (
-                    status_name(r),
-                    None,
-                    Some(RunJson {
-                        inflections: r.after.inflections,
-                        vibrations: r.after.vibrations,
-                        sum_displacement: r.sum_displacement,
-                        max_displacement: r.max_displacement,
-                        strain_energy: r.after.strain_energy,
-                        gfi: r.after.gfi,
-                        seconds: r.elapsed_seconds,
-                        tolerance_met: r.tolerance_met,
-                        iterations: r.iterations,
-                        parameters: &r.parameters,
-                        after: &r.after,
-                    }),
-                ),
-                Outcome::Failed(msg) => ("failed".to_string(), Some(msg.as_str()), None),
-                Outcome::Skipped(why) => ("skipped".to_string(), Some(why.as_str()), None),
+                ComparisonOutcome::Ran(f) => {
+                    let r = &f.report;
+                    (
+                        status_name(r),
+                        None,
+                        Some(RunJson {
+                            inflections: r.after.inflections,
+                            vibrations: r.after.vibrations,
+                            sum_displacement: r.sum_displacement,
+                            max_displacement: r.max_displacement,
+                            strain_energy: r.after.strain_energy,
+                            gfi: r.after.gfi,
+                            seconds: r.elapsed_seconds,
+                            tolerance_met: r.tolerance_met,
+                            iterations: r.iterations,
+                            parameters: &r.parameters,
+                            after: &r.after,
+                        }),
+                    )
+                }
+                ComparisonOutcome::Failed(e) => ("failed".to_string(), Some(e.to_string()), None),
+                ComparisonOutcome::Skipped(why) => ("skipped".to_string(), Some(why.clone()), None),
             };
             RowJson {
                 method: row.method,

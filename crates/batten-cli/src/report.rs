@@ -2,24 +2,25 @@
 //! the input's metrics and plots, the table of `batten compare`, and for every method the
 //! faired curve's comb and κ(s) drawn over the input's.
 //!
-//! The methods are run by [`crate::compare`] (the same runs, options and table as
-//! `batten compare`); the page has inline SVG and CSS only: no scripts, fonts or other
-//! resources to fetch.
+//! The methods are run by the library's [`batten::fair::compare`], as in `batten compare`
+//! (the same runs, options and table); the page has inline SVG and CSS only: no scripts,
+//! fonts or other resources to fetch.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use batten::fair::{self, ComparisonOutcome, ComparisonRow};
 use batten::io::{self, format_f64};
 use batten::plot::{PlotKind, PlotOptions, auto_comb_scale, render};
 use batten::{FairOptions, FairnessMetrics, PointSeq};
 use clap::Args;
 
-use crate::compare::{self, Outcome, Row};
-use crate::failure::{EXIT_FAILED, Failure};
+use crate::compare;
+use crate::failure::Failure;
 use crate::input;
-use crate::output::{self, sig};
+use crate::output::sig;
 use crate::plot::{check_output, render_failure};
 
 /// Significant digits of the metrics table.
@@ -79,23 +80,12 @@ pub fn run(args: &ReportArgs) -> Result<ExitCode, Failure> {
     let before = FairnessMetrics::of_seq(&data.seq)
         .map_err(|e| Failure::from_batten(&format!("{name}: cannot analyse"), e))?;
 
-    let rows = compare::run_methods(&methods, &data.seq, &base);
-    let table = compare::markdown(&name, &data.seq, &base, &before, &rows);
-    let page = page(&name, &data.seq, &base, &before, &rows, &table)?;
+    let comparison = fair::compare(&methods, &data.seq, &base);
+    let rows = &comparison.rows;
+    let table = compare::markdown(&name, &data.seq, &base, &before, rows);
+    let page = page(&name, &data.seq, &base, &before, rows, &table)?;
     io::write_atomic(&args.output, page.as_bytes()).map_err(Failure::failed)?;
-
-    let mut failed = false;
-    for row in &rows {
-        if let Outcome::Failed(msg) = &row.outcome {
-            output::error_line(&format!("{name}: method {} failed: {msg}", row.method));
-            failed = true;
-        }
-    }
-    Ok(if failed {
-        ExitCode::from(EXIT_FAILED)
-    } else {
-        ExitCode::SUCCESS
-    })
+    Ok(compare::exit_code(&name, &comparison))
 }
 
 /// The page's style sheet.
@@ -130,19 +120,18 @@ fn page(
     seq: &PointSeq,
     base: &FairOptions,
     before: &FairnessMetrics,
-    rows: &[Row],
+    rows: &[ComparisonRow],
     table: &str,
 ) -> Result<String, Failure> {
     // One faired point sequence per method that ran (or why there is none).
     let faired: Vec<Result<PointSeq, String>> = rows
         .iter()
-        .map(|row| match (&row.outcome, &row.points) {
-            (Outcome::Ran(_), Some(p)) => seq
-                .with_points(p.clone())
+        .map(|row| match &row.outcome {
+            ComparisonOutcome::Ran(f) => seq
+                .with_points(f.points.clone())
                 .map_err(|e| format!("the faired points cannot be drawn: {e}")),
-            (Outcome::Failed(msg), _) => Err(format!("failed: {msg}")),
-            (Outcome::Skipped(why), _) => Err(format!("skipped: {why}")),
-            (Outcome::Ran(_), None) => Err("no faired points".to_string()),
+            ComparisonOutcome::Failed(e) => Err(format!("failed: {e}")),
+            ComparisonOutcome::Skipped(why) => Err(format!("skipped: {why}")),
         })
         .collect();
     let drawn: Vec<&PointSeq> = faired.iter().filter_map(|f| f.as_ref().ok()).collect();
