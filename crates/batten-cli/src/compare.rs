@@ -47,7 +47,7 @@ pub fn run(args: &CompareArgs) -> Result<ExitCode, Failure> {
     let comparison = fair::compare(&methods, &data.seq, &base);
     let rows = &comparison.rows;
     let text = match args.format {
-        TableFormat::Md => markdown(&name, &data.seq, &base, &before, rows),
+        TableFormat::Md => markdown(&table(&name, &data.seq, &base, &before, rows)),
         TableFormat::Csv => csv(&before, rows),
         TableFormat::Json => {
             let mut s = serde_json::to_string_pretty(&to_json(&name, &base, &before, rows))
@@ -93,7 +93,7 @@ pub(crate) fn resolve(names: &[String]) -> Result<Vec<&'static dyn FairMethod>, 
     Ok(out)
 }
 
-/// Remarks under the Markdown table: why options differ, failures, missed tolerances.
+/// Remarks under the table: why options differ, failures, missed tolerances.
 fn remarks(row: &ComparisonRow) -> Vec<String> {
     let mut v: Vec<String> = row.note.iter().cloned().collect();
     match &row.outcome {
@@ -108,15 +108,39 @@ fn remarks(row: &ComparisonRow) -> Vec<String> {
     v
 }
 
-pub(crate) fn markdown(
+/// The table's columns: title, and whether its cells are numbers (aligned right).
+pub(crate) const COLUMNS: [(&str, bool); 7] = [
+    ("Method", false),
+    ("Infl", true),
+    ("Vib", true),
+    ("S_d/M_d", true),
+    ("E_s", true),
+    ("GFI", true),
+    ("time", true),
+];
+
+/// The comparison table as text cells: what the Markdown of `batten compare` and the HTML of
+/// `batten report` both show.
+pub(crate) struct Table {
+    /// The line above the table: the input, its size, the tolerance, the ends held.
+    pub(crate) caption: String,
+    /// The input's row, then one per method: a cell per column of [`COLUMNS`] (empty when a
+    /// method did not run). A method with remarks has their number after its name (`mst [1]`).
+    pub(crate) rows: Vec<[String; COLUMNS.len()]>,
+    /// The remarks, numbered from 1 in order: `method: remark; remark`.
+    pub(crate) notes: Vec<String>,
+}
+
+/// The table of `rows`, after a row of the input's metrics `before`.
+pub(crate) fn table(
     name: &str,
     seq: &PointSeq,
     base: &FairOptions,
     before: &FairnessMetrics,
     rows: &[ComparisonRow],
-) -> String {
-    let mut s = format!(
-        "{name}: {} points, {}; tolerance {}{}\n\n",
+) -> Table {
+    let caption = format!(
+        "{name}: {} points, {}; tolerance {}{}",
         seq.len(),
         if seq.is_closed() { "closed" } else { "open" },
         base.tolerance
@@ -127,56 +151,90 @@ pub(crate) fn markdown(
             String::new()
         },
     );
-    s.push_str("| Method | Infl | Vib | S_d/M_d | E_s | GFI | time |\n");
-    s.push_str("| :-- | --: | --: | --: | --: | --: | --: |\n");
-    // Writing to a String cannot fail.
-    let _ = writeln!(
-        s,
-        "| input | {} | {} | – | {} | {} | – |",
-        before.inflections,
-        before.vibrations,
+    let mut cells = vec![[
+        "input".to_string(),
+        before.inflections.to_string(),
+        before.vibrations.to_string(),
+        "–".to_string(),
         sig(before.strain_energy, DIGITS),
-        sig(before.gfi, DIGITS)
-    );
+        sig(before.gfi, DIGITS),
+        "–".to_string(),
+    ]];
     let mut notes = Vec::new();
     for row in rows {
         let r = remarks(row);
-        let mark = if r.is_empty() {
-            String::new()
+        let method = if r.is_empty() {
+            row.method.to_string()
         } else {
-            notes.push((row.method, r));
-            format!(" [{}]", notes.len())
+            notes.push(format!("{}: {}", row.method, r.join("; ")));
+            format!("{} [{}]", row.method, notes.len())
         };
-        let _ = match &row.outcome {
+        let not_run = |status: &str| {
+            let mut c: [String; COLUMNS.len()] = Default::default();
+            c[0] = method.clone();
+            c[1] = status.to_string();
+            c
+        };
+        cells.push(match &row.outcome {
             ComparisonOutcome::Ran(f) => {
                 let rep = &f.report;
-                writeln!(
-                    s,
-                    "| {}{mark} | {} | {} | {}/{} | {} | {} | {} |",
-                    row.method,
-                    rep.after.inflections,
-                    rep.after.vibrations,
-                    sig(rep.sum_displacement, DIGITS),
-                    sig(rep.max_displacement, DIGITS),
+                [
+                    method.clone(),
+                    rep.after.inflections.to_string(),
+                    rep.after.vibrations.to_string(),
+                    format!(
+                        "{}/{}",
+                        sig(rep.sum_displacement, DIGITS),
+                        sig(rep.max_displacement, DIGITS)
+                    ),
                     sig(rep.after.strain_energy, DIGITS),
                     sig(rep.after.gfi, DIGITS),
                     seconds(rep.elapsed_seconds),
-                )
+                ]
             }
-            ComparisonOutcome::Failed(_) => {
-                writeln!(s, "| {}{mark} | failed | | | | | |", row.method)
-            }
-            ComparisonOutcome::Skipped(_) => {
-                writeln!(s, "| {}{mark} | skipped | | | | | |", row.method)
-            }
-        };
+            ComparisonOutcome::Failed(_) => not_run("failed"),
+            ComparisonOutcome::Skipped(_) => not_run("skipped"),
+        });
     }
-    if !notes.is_empty() {
+    Table {
+        caption,
+        rows: cells,
+        notes,
+    }
+}
+
+/// The table as Markdown: the caption, a pipe table, the numbered notes.
+pub(crate) fn markdown(table: &Table) -> String {
+    let mut s = format!("{}\n\n", table.caption);
+    s.push_str(&pipe_row(COLUMNS.iter().map(|c| c.0)));
+    s.push_str(&pipe_row(
+        COLUMNS.iter().map(|c| if c.1 { "--:" } else { ":--" }),
+    ));
+    for row in &table.rows {
+        s.push_str(&pipe_row(row.iter().map(String::as_str)));
+    }
+    if !table.notes.is_empty() {
         s.push('\n');
-        for (i, (method, r)) in notes.iter().enumerate() {
-            let _ = writeln!(s, "[{}] {method}: {}", i + 1, r.join("; "));
+        for (i, note) in table.notes.iter().enumerate() {
+            // Writing to a String cannot fail.
+            let _ = writeln!(s, "[{}] {note}", i + 1);
         }
     }
+    s
+}
+
+/// One line of a Markdown pipe table: `| a | b |`, an empty cell as `| |`.
+fn pipe_row<'a>(cells: impl Iterator<Item = &'a str>) -> String {
+    let mut s = String::from("|");
+    for c in cells {
+        s.push(' ');
+        if !c.is_empty() {
+            s.push_str(c);
+            s.push(' ');
+        }
+        s.push('|');
+    }
+    s.push('\n');
     s
 }
 
@@ -352,5 +410,38 @@ fn to_json<'a>(
         fixed_ends: base.fix_ends,
         before,
         rows,
+    }
+}
+
+/// A small table for the tests of its Markdown here and its HTML in `report`: an input row,
+/// a failed method, and text that HTML must escape.
+#[cfg(test)]
+pub(crate) fn example_table() -> Table {
+    Table {
+        caption: "a<b>.csv: 4 points, open; tolerance none".to_string(),
+        rows: vec![
+            ["input", "3", "1", "–", "2.000", "5.000", "–"].map(String::from),
+            ["mst [1]", "failed", "", "", "", "", ""].map(String::from),
+        ],
+        notes: vec!["mst: failed: p < 0 & \"q\"".to_string()],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn markdown_of_a_table() {
+        assert_eq!(
+            markdown(&example_table()),
+            "a<b>.csv: 4 points, open; tolerance none\n\n\
+             | Method | Infl | Vib | S_d/M_d | E_s | GFI | time |\n\
+             | :-- | --: | --: | --: | --: | --: | --: |\n\
+             | input | 3 | 1 | – | 2.000 | 5.000 | – |\n\
+             | mst [1] | failed | | | | | |\n\
+             \n\
+             [1] mst: failed: p < 0 & \"q\"\n"
+        );
     }
 }
