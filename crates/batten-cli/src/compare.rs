@@ -1,19 +1,18 @@
 //! `batten compare`: several methods on one input, tabulated like Table 1 of Han et al.
 //! (`Infl_num`, `Vib_num`, `S_d/M_d`, `E_s`), with Calì's GFI and the run time added.
 //!
-//! As in the paper, the smoothing spline `mst` is run at the same largest displacement as the
-//! first method listed: with `tolerance` = that method's `M_d` and no `p`, which makes `mst`
-//! bisect on `p`. When `mst` is listed first it runs with the options given.
+//! The runs are the library's comparison protocol ([`fair::compare`]: as in the paper, the
+//! smoothing spline `mst` at the same largest displacement as the first method listed); this
+//! module resolves `--methods` and formats the rows.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::process::ExitCode;
 
 use anyhow::anyhow;
-use batten::fair::{self, EndFix, FairMethod, FairReport};
+use batten::fair::{self, Comparison, ComparisonOutcome, ComparisonRow, EndFix, FairMethod};
 use batten::io::format_f64;
-use batten::{FairOptions, FairnessMetrics, Point, PointSeq};
-use rayon::prelude::*;
+use batten::{FairOptions, FairReport, FairnessMetrics, PointSeq};
 use serde::Serialize;
 
 use crate::failure::{EXIT_FAILED, Failure};
@@ -21,33 +20,8 @@ use crate::input;
 use crate::output::{self, seconds, sig};
 use crate::{CompareArgs, TableFormat};
 
-/// The method that is run at the displacement of the first one.
-const MST: &str = "mst";
-
 /// Significant digits of real numbers in the Markdown table.
 const DIGITS: usize = 4;
-
-/// How one method's run ended.
-#[derive(Debug)]
-pub(crate) enum Outcome {
-    Ran(Box<FairReport>),
-    Failed(String),
-    /// Not run, and why (e.g. a closed curve for a method that takes only open ones).
-    Skipped(String),
-}
-
-/// One row of the table.
-#[derive(Debug)]
-pub(crate) struct Row {
-    pub(crate) method: &'static str,
-    /// The tolerance the method ran with.
-    tolerance: Option<f64>,
-    /// Why the options differ from the ones given, if they do.
-    note: Option<String>,
-    pub(crate) outcome: Outcome,
-    /// The faired points, when the method ran (`batten report` draws them).
-    pub(crate) points: Option<Vec<Point>>,
-}
 
 /// Run `batten compare`.
 ///
@@ -70,30 +44,34 @@ pub fn run(args: &CompareArgs) -> Result<ExitCode, Failure> {
     let before = FairnessMetrics::of_seq(&data.seq)
         .map_err(|e| Failure::from_batten(&format!("{name}: cannot analyse"), e))?;
 
-    let rows = run_methods(&methods, &data.seq, &base);
+    let comparison = fair::compare(&methods, &data.seq, &base);
+    let rows = &comparison.rows;
     let text = match args.format {
-        TableFormat::Md => markdown(&name, &data.seq, &base, &before, &rows),
-        TableFormat::Csv => csv(&before, &rows),
+        TableFormat::Md => markdown(&table(&name, &data.seq, &base, &before, rows)),
+        TableFormat::Csv => csv(&before, rows),
         TableFormat::Json => {
-            let mut s = serde_json::to_string_pretty(&to_json(&name, &base, &before, &rows))
+            let mut s = serde_json::to_string_pretty(&to_json(&name, &base, &before, rows))
                 .map_err(|e| Failure::failed(anyhow!("cannot encode the table: {e}")))?;
             s.push('\n');
             s
         }
     };
     output::stdout(&text)?;
+    Ok(exit_code(&name, &comparison))
+}
+
+/// One error line per method that failed; exit code 1 if one did, else 0.
+pub(crate) fn exit_code(name: &str, comparison: &Comparison) -> ExitCode {
     let mut failed = false;
-    for row in &rows {
-        if let Outcome::Failed(msg) = &row.outcome {
-            output::error_line(&format!("{name}: method {} failed: {msg}", row.method));
-            failed = true;
-        }
+    for (method, e) in comparison.failures() {
+        output::error_line(&format!("{name}: method {method} failed: {e}"));
+        failed = true;
     }
-    Ok(if failed {
+    if failed {
         ExitCode::from(EXIT_FAILED)
     } else {
         ExitCode::SUCCESS
-    })
+    }
 }
 
 /// The methods named (all registered when none), each once.
@@ -115,111 +93,54 @@ pub(crate) fn resolve(names: &[String]) -> Result<Vec<&'static dyn FairMethod>, 
     Ok(out)
 }
 
-/// Run every method (in parallel), `mst` at the first method's displacement.
-pub(crate) fn run_methods(
-    methods: &[&'static dyn FairMethod],
-    seq: &PointSeq,
-    base: &FairOptions,
-) -> Vec<Row> {
-    let Some((&first, rest)) = methods.split_first() else {
-        return Vec::new();
-    };
-    if first.name() == MST || !rest.iter().any(|m| m.name() == MST) {
-        return methods
-            .par_iter()
-            .map(|&m| run_one(m, seq, base.clone(), None))
-            .collect();
-    }
-    let first_row = run_one(first, seq, base.clone(), None);
-    let (mst_options, mst_note) = match &first_row.outcome {
-        Outcome::Ran(r) if r.max_displacement > 0.0 => {
-            let mut o = base.clone();
-            o.tolerance = Some(r.max_displacement);
-            o.params.clear();
-            let note = format!(
-                "run at tolerance {}, the max displacement of {} (as in Han et al.)",
-                sig(r.max_displacement, DIGITS),
-                first.name()
-            );
-            (o, note)
-        }
-        Outcome::Ran(_) => (
-            base.clone(),
-            format!(
-                "{} moved no point, so {MST} ran with the options given",
-                first.name()
-            ),
-        ),
-        _ => (
-            base.clone(),
-            format!(
-                "{} did not run, so {MST} ran with the options given",
-                first.name()
-            ),
-        ),
-    };
-    let mut rows = vec![first_row];
-    rows.par_extend(rest.par_iter().map(|&m| {
-        if m.name() == MST {
-            run_one(m, seq, mst_options.clone(), Some(mst_note.clone()))
-        } else {
-            run_one(m, seq, base.clone(), None)
-        }
-    }));
-    rows
-}
-
-fn run_one(
-    m: &'static dyn FairMethod,
-    seq: &PointSeq,
-    options: FairOptions,
-    note: Option<String>,
-) -> Row {
-    let mut points = None;
-    let outcome = if seq.is_closed() && !m.supports_closed() {
-        Outcome::Skipped("does not support closed curves".to_string())
-    } else {
-        match fair::fair_with(m, seq, &options) {
-            Ok(f) => {
-                points = Some(f.points);
-                Outcome::Ran(Box::new(f.report))
-            }
-            Err(e) => Outcome::Failed(e.to_string()),
-        }
-    };
-    Row {
-        method: m.name(),
-        tolerance: options.tolerance,
-        note,
-        outcome,
-        points,
-    }
-}
-
-/// Remarks under the Markdown table: why options differ, failures, missed tolerances.
-fn remarks(row: &Row) -> Vec<String> {
+/// Remarks under the table: why options differ, failures, missed tolerances.
+fn remarks(row: &ComparisonRow) -> Vec<String> {
     let mut v: Vec<String> = row.note.iter().cloned().collect();
     match &row.outcome {
-        Outcome::Ran(r) if !r.tolerance_met => v.push(format!(
+        ComparisonOutcome::Ran(f) if !f.report.tolerance_met => v.push(format!(
             "tolerance {} not met",
-            r.tolerance.map_or_else(String::new, format_f64)
+            f.report.tolerance.map_or_else(String::new, format_f64)
         )),
-        Outcome::Ran(_) => {}
-        Outcome::Failed(msg) => v.push(format!("failed: {msg}")),
-        Outcome::Skipped(why) => v.push(format!("skipped: {why}")),
+        ComparisonOutcome::Ran(_) => {}
+        ComparisonOutcome::Failed(e) => v.push(format!("failed: {e}")),
+        ComparisonOutcome::Skipped(why) => v.push(format!("skipped: {why}")),
     }
     v
 }
 
-pub(crate) fn markdown(
+/// The table's columns: title, and whether its cells are numbers (aligned right).
+pub(crate) const COLUMNS: [(&str, bool); 7] = [
+    ("Method", false),
+    ("Infl", true),
+    ("Vib", true),
+    ("S_d/M_d", true),
+    ("E_s", true),
+    ("GFI", true),
+    ("time", true),
+];
+
+/// The comparison table as text cells: what the Markdown of `batten compare` and the HTML of
+/// `batten report` both show.
+pub(crate) struct Table {
+    /// The line above the table: the input, its size, the tolerance, the ends held.
+    pub(crate) caption: String,
+    /// The input's row, then one per method: a cell per column of [`COLUMNS`] (empty when a
+    /// method did not run). A method with remarks has their number after its name (`mst [1]`).
+    pub(crate) rows: Vec<[String; COLUMNS.len()]>,
+    /// The remarks, numbered from 1 in order: `method: remark; remark`.
+    pub(crate) notes: Vec<String>,
+}
+
+/// The table of `rows`, after a row of the input's metrics `before`.
+pub(crate) fn table(
     name: &str,
     seq: &PointSeq,
     base: &FairOptions,
     before: &FairnessMetrics,
-    rows: &[Row],
-) -> String {
-    let mut s = format!(
-        "{name}: {} points, {}; tolerance {}{}\n\n",
+    rows: &[ComparisonRow],
+) -> Table {
+    let caption = format!(
+        "{name}: {} points, {}; tolerance {}{}",
         seq.len(),
         if seq.is_closed() { "closed" } else { "open" },
         base.tolerance
@@ -230,49 +151,90 @@ pub(crate) fn markdown(
             String::new()
         },
     );
-    s.push_str("| Method | Infl | Vib | S_d/M_d | E_s | GFI | time |\n");
-    s.push_str("| :-- | --: | --: | --: | --: | --: | --: |\n");
-    // Writing to a String cannot fail.
-    let _ = writeln!(
-        s,
-        "| input | {} | {} | – | {} | {} | – |",
-        before.inflections,
-        before.vibrations,
+    let mut cells = vec![[
+        "input".to_string(),
+        before.inflections.to_string(),
+        before.vibrations.to_string(),
+        "–".to_string(),
         sig(before.strain_energy, DIGITS),
-        sig(before.gfi, DIGITS)
-    );
+        sig(before.gfi, DIGITS),
+        "–".to_string(),
+    ]];
     let mut notes = Vec::new();
     for row in rows {
         let r = remarks(row);
-        let mark = if r.is_empty() {
-            String::new()
+        let method = if r.is_empty() {
+            row.method.to_string()
         } else {
-            notes.push((row.method, r));
-            format!(" [{}]", notes.len())
+            notes.push(format!("{}: {}", row.method, r.join("; ")));
+            format!("{} [{}]", row.method, notes.len())
         };
-        let _ = match &row.outcome {
-            Outcome::Ran(rep) => writeln!(
-                s,
-                "| {}{mark} | {} | {} | {}/{} | {} | {} | {} |",
-                row.method,
-                rep.after.inflections,
-                rep.after.vibrations,
-                sig(rep.sum_displacement, DIGITS),
-                sig(rep.max_displacement, DIGITS),
-                sig(rep.after.strain_energy, DIGITS),
-                sig(rep.after.gfi, DIGITS),
-                seconds(rep.elapsed_seconds),
-            ),
-            Outcome::Failed(_) => writeln!(s, "| {}{mark} | failed | | | | | |", row.method),
-            Outcome::Skipped(_) => writeln!(s, "| {}{mark} | skipped | | | | | |", row.method),
+        let not_run = |status: &str| {
+            let mut c: [String; COLUMNS.len()] = Default::default();
+            c[0] = method.clone();
+            c[1] = status.to_string();
+            c
         };
+        cells.push(match &row.outcome {
+            ComparisonOutcome::Ran(f) => {
+                let rep = &f.report;
+                [
+                    method.clone(),
+                    rep.after.inflections.to_string(),
+                    rep.after.vibrations.to_string(),
+                    format!(
+                        "{}/{}",
+                        sig(rep.sum_displacement, DIGITS),
+                        sig(rep.max_displacement, DIGITS)
+                    ),
+                    sig(rep.after.strain_energy, DIGITS),
+                    sig(rep.after.gfi, DIGITS),
+                    seconds(rep.elapsed_seconds),
+                ]
+            }
+            ComparisonOutcome::Failed(_) => not_run("failed"),
+            ComparisonOutcome::Skipped(_) => not_run("skipped"),
+        });
     }
-    if !notes.is_empty() {
+    Table {
+        caption,
+        rows: cells,
+        notes,
+    }
+}
+
+/// The table as Markdown: the caption, a pipe table, the numbered notes.
+pub(crate) fn markdown(table: &Table) -> String {
+    let mut s = format!("{}\n\n", table.caption);
+    s.push_str(&pipe_row(COLUMNS.iter().map(|c| c.0)));
+    s.push_str(&pipe_row(
+        COLUMNS.iter().map(|c| if c.1 { "--:" } else { ":--" }),
+    ));
+    for row in &table.rows {
+        s.push_str(&pipe_row(row.iter().map(String::as_str)));
+    }
+    if !table.notes.is_empty() {
         s.push('\n');
-        for (i, (method, r)) in notes.iter().enumerate() {
-            let _ = writeln!(s, "[{}] {method}: {}", i + 1, r.join("; "));
+        for (i, note) in table.notes.iter().enumerate() {
+            // Writing to a String cannot fail.
+            let _ = writeln!(s, "[{}] {note}", i + 1);
         }
     }
+    s
+}
+
+/// One line of a Markdown pipe table: `| a | b |`, an empty cell as `| |`.
+fn pipe_row<'a>(cells: impl Iterator<Item = &'a str>) -> String {
+    let mut s = String::from("|");
+    for c in cells {
+        s.push(' ');
+        if !c.is_empty() {
+            s.push_str(c);
+            s.push(' ');
+        }
+        s.push('|');
+    }
+    s.push('\n');
     s
 }
 
@@ -294,7 +256,7 @@ pub fn csv_num(x: f64) -> String {
     }
 }
 
-fn csv(before: &FairnessMetrics, rows: &[Row]) -> String {
+fn csv(before: &FairnessMetrics, rows: &[ComparisonRow]) -> String {
     let mut s = String::from(
         "method,inflections,vibrations,sum_displacement,max_displacement,strain_energy,gfi,\
          seconds,tolerance,tolerance_met,status,note\n",
@@ -312,27 +274,30 @@ fn csv(before: &FairnessMetrics, rows: &[Row]) -> String {
         let tol = row.tolerance.map(csv_num).unwrap_or_default();
         let note = csv_field(&row.note.clone().unwrap_or_default());
         let _ = match &row.outcome {
-            Outcome::Ran(r) => writeln!(
-                s,
-                "{},{},{},{},{},{},{},{},{tol},{},{},{note}",
-                row.method,
-                r.after.inflections,
-                r.after.vibrations,
-                csv_num(r.sum_displacement),
-                csv_num(r.max_displacement),
-                csv_num(r.after.strain_energy),
-                csv_num(r.after.gfi),
-                csv_num(r.elapsed_seconds),
-                r.tolerance_met,
-                status_name(r),
-            ),
-            Outcome::Failed(msg) => writeln!(
+            ComparisonOutcome::Ran(f) => {
+                let r = &f.report;
+                writeln!(
+                    s,
+                    "{},{},{},{},{},{},{},{},{tol},{},{},{note}",
+                    row.method,
+                    r.after.inflections,
+                    r.after.vibrations,
+                    csv_num(r.sum_displacement),
+                    csv_num(r.max_displacement),
+                    csv_num(r.after.strain_energy),
+                    csv_num(r.after.gfi),
+                    csv_num(r.elapsed_seconds),
+                    r.tolerance_met,
+                    status_name(r),
+                )
+            }
+            ComparisonOutcome::Failed(e) => writeln!(
                 s,
                 "{},,,,,,,,{tol},,failed,{}",
                 row.method,
-                csv_field(&join_note(row.note.as_deref(), msg))
+                csv_field(&join_note(row.note.as_deref(), &e.to_string()))
             ),
-            Outcome::Skipped(why) => writeln!(
+            ComparisonOutcome::Skipped(why) => writeln!(
                 s,
                 "{},,,,,,,,{tol},,skipped,{}",
                 row.method,
@@ -375,7 +340,7 @@ struct RowJson<'a> {
     note: Option<&'a str>,
     status: String,
     #[serde(skip_serializing_if = "Option::is_none")]
-    error: Option<&'a str>,
+    error: Option<String>,
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     result: Option<RunJson<'a>>,
 }
@@ -399,31 +364,34 @@ fn to_json<'a>(
     name: &'a str,
     base: &FairOptions,
     before: &'a FairnessMetrics,
-    rows: &'a [Row],
+    rows: &'a [ComparisonRow],
 ) -> CompareJson<'a> {
     let rows = rows
         .iter()
         .map(|row| {
             let (status, error, result) = match &row.outcome {
-                Outcome::Ran(r) => (
-                    status_name(r),
-                    None,
-                    Some(RunJson {
-                        inflections: r.after.inflections,
-                        vibrations: r.after.vibrations,
-                        sum_displacement: r.sum_displacement,
-                        max_displacement: r.max_displacement,
-                        strain_energy: r.after.strain_energy,
-                        gfi: r.after.gfi,
-                        seconds: r.elapsed_seconds,
-                        tolerance_met: r.tolerance_met,
-                        iterations: r.iterations,
-                        parameters: &r.parameters,
-                        after: &r.after,
-                    }),
-                ),
-                Outcome::Failed(msg) => ("failed".to_string(), Some(msg.as_str()), None),
-                Outcome::Skipped(why) => ("skipped".to_string(), Some(why.as_str()), None),
+                ComparisonOutcome::Ran(f) => {
+                    let r = &f.report;
+                    (
+                        status_name(r),
+                        None,
+                        Some(RunJson {
+                            inflections: r.after.inflections,
+                            vibrations: r.after.vibrations,
+                            sum_displacement: r.sum_displacement,
+                            max_displacement: r.max_displacement,
+                            strain_energy: r.after.strain_energy,
+                            gfi: r.after.gfi,
+                            seconds: r.elapsed_seconds,
+                            tolerance_met: r.tolerance_met,
+                            iterations: r.iterations,
+                            parameters: &r.parameters,
+                            after: &r.after,
+                        }),
+                    )
+                }
+                ComparisonOutcome::Failed(e) => ("failed".to_string(), Some(e.to_string()), None),
+                ComparisonOutcome::Skipped(why) => ("skipped".to_string(), Some(why.clone()), None),
             };
             RowJson {
                 method: row.method,
@@ -442,5 +410,38 @@ fn to_json<'a>(
         fixed_ends: base.fix_ends,
         before,
         rows,
+    }
+}
+
+/// A small table for the tests of its Markdown here and its HTML in `report`: an input row,
+/// a failed method, and text that HTML must escape.
+#[cfg(test)]
+pub(crate) fn example_table() -> Table {
+    Table {
+        caption: "a<b>.csv: 4 points, open; tolerance none".to_string(),
+        rows: vec![
+            ["input", "3", "1", "–", "2.000", "5.000", "–"].map(String::from),
+            ["mst [1]", "failed", "", "", "", "", ""].map(String::from),
+        ],
+        notes: vec!["mst: failed: p < 0 & \"q\"".to_string()],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn markdown_of_a_table() {
+        assert_eq!(
+            markdown(&example_table()),
+            "a<b>.csv: 4 points, open; tolerance none\n\n\
+             | Method | Infl | Vib | S_d/M_d | E_s | GFI | time |\n\
+             | :-- | --: | --: | --: | --: | --: | --: |\n\
+             | input | 3 | 1 | – | 2.000 | 5.000 | – |\n\
+             | mst [1] | failed | | | | | |\n\
+             \n\
+             [1] mst: failed: p < 0 & \"q\"\n"
+        );
     }
 }

@@ -31,25 +31,9 @@ pub fn error_line(message: &str) {
     note(&format!("error: {message}"));
 }
 
-/// `x` with `digits` significant digits: fixed notation for magnitudes in `[1e-3, 1e6)`,
-/// exponent notation otherwise (`1.234e9`).
-pub fn sig(x: f64, digits: usize) -> String {
-    if !x.is_finite() {
-        return x.to_string();
-    }
-    if x == 0.0 {
-        return "0".to_string();
-    }
-    let digits = digits.max(1);
-    let exp = x.abs().log10().floor();
-    if (-3.0..6.0).contains(&exp) {
-        // exp is a small integer here, so the conversion is exact.
-        let decimals = (digits as f64 - 1.0 - exp).max(0.0) as usize;
-        format!("{x:.decimals$}")
-    } else {
-        format!("{x:.prec$e}", prec = digits - 1)
-    }
-}
+/// `x` with `digits` significant digits (the library's, so that the notes it writes read
+/// like the CLI's tables).
+pub use batten::io::format_sig as sig;
 
 /// A count and its noun, singular for one: `count(1, "file")` is `1 file`, `count(2, "file")`
 /// is `2 files`.
@@ -75,20 +59,6 @@ pub fn seconds(s: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn significant_digits() {
-        assert_eq!(sig(0.0, 4), "0");
-        assert_eq!(sig(1.23456, 4), "1.235");
-        assert_eq!(sig(-123.456, 4), "-123.5");
-        assert_eq!(sig(0.0012345, 3), "0.00123");
-        assert_eq!(sig(1.5e9, 4), "1.500e9");
-        assert_eq!(sig(2.5e-7, 2), "2.5e-7");
-        assert_eq!(sig(123456.0, 4), "123456");
-        assert_eq!(sig(1234567.0, 4), "1.235e6");
-        assert_eq!(sig(f64::INFINITY, 4), "inf");
-        assert_eq!(sig(f64::NAN, 4), "NaN");
-    }
 
     #[test]
     fn counts() {

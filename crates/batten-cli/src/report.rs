@@ -2,24 +2,25 @@
 //! the input's metrics and plots, the table of `batten compare`, and for every method the
 //! faired curve's comb and κ(s) drawn over the input's.
 //!
-//! The methods are run by [`crate::compare`] (the same runs, options and table as
-//! `batten compare`); the page has inline SVG and CSS only: no scripts, fonts or other
-//! resources to fetch.
+//! The methods are run by the library's [`batten::fair::compare`], as in `batten compare`
+//! (the same runs, options and table); the page has inline SVG and CSS only: no scripts,
+//! fonts or other resources to fetch.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use batten::fair::{self, ComparisonOutcome, ComparisonRow};
 use batten::io::{self, format_f64};
 use batten::plot::{PlotKind, PlotOptions, auto_comb_scale, render};
 use batten::{FairOptions, FairnessMetrics, PointSeq};
 use clap::Args;
 
-use crate::compare::{self, Outcome, Row};
-use crate::failure::{EXIT_FAILED, Failure};
+use crate::compare::{self, COLUMNS, Table};
+use crate::failure::Failure;
 use crate::input;
-use crate::output::{self, sig};
+use crate::output::sig;
 use crate::plot::{check_output, render_failure};
 
 /// Significant digits of the metrics table.
@@ -79,23 +80,12 @@ pub fn run(args: &ReportArgs) -> Result<ExitCode, Failure> {
     let before = FairnessMetrics::of_seq(&data.seq)
         .map_err(|e| Failure::from_batten(&format!("{name}: cannot analyse"), e))?;
 
-    let rows = compare::run_methods(&methods, &data.seq, &base);
-    let table = compare::markdown(&name, &data.seq, &base, &before, &rows);
-    let page = page(&name, &data.seq, &base, &before, &rows, &table)?;
+    let comparison = fair::compare(&methods, &data.seq, &base);
+    let rows = &comparison.rows;
+    let table = compare::table(&name, &data.seq, &base, &before, rows);
+    let page = page(&name, &data.seq, &base, &before, rows, &table)?;
     io::write_atomic(&args.output, page.as_bytes()).map_err(Failure::failed)?;
-
-    let mut failed = false;
-    for row in &rows {
-        if let Outcome::Failed(msg) = &row.outcome {
-            output::error_line(&format!("{name}: method {} failed: {msg}", row.method));
-            failed = true;
-        }
-    }
-    Ok(if failed {
-        ExitCode::from(EXIT_FAILED)
-    } else {
-        ExitCode::SUCCESS
-    })
+    Ok(compare::exit_code(&name, &comparison))
 }
 
 /// The page's style sheet.
@@ -130,19 +120,18 @@ fn page(
     seq: &PointSeq,
     base: &FairOptions,
     before: &FairnessMetrics,
-    rows: &[Row],
-    table: &str,
+    rows: &[ComparisonRow],
+    table: &Table,
 ) -> Result<String, Failure> {
     // One faired point sequence per method that ran (or why there is none).
     let faired: Vec<Result<PointSeq, String>> = rows
         .iter()
-        .map(|row| match (&row.outcome, &row.points) {
-            (Outcome::Ran(_), Some(p)) => seq
-                .with_points(p.clone())
+        .map(|row| match &row.outcome {
+            ComparisonOutcome::Ran(f) => seq
+                .with_points(f.points.clone())
                 .map_err(|e| format!("the faired points cannot be drawn: {e}")),
-            (Outcome::Failed(msg), _) => Err(format!("failed: {msg}")),
-            (Outcome::Skipped(why), _) => Err(format!("skipped: {why}")),
-            (Outcome::Ran(_), None) => Err("no faired points".to_string()),
+            ComparisonOutcome::Failed(e) => Err(format!("failed: {e}")),
+            ComparisonOutcome::Skipped(why) => Err(format!("skipped: {why}")),
         })
         .collect();
     let drawn: Vec<&PointSeq> = faired.iter().filter_map(|f| f.as_ref().ok()).collect();
@@ -197,7 +186,7 @@ fn page(
     h.push_str("</div>\n");
 
     h.push_str("<h2>Comparison</h2>\n");
-    h.push_str(&markdown_to_html(table));
+    h.push_str(&table_html(table));
 
     for (row, f) in rows.iter().zip(&faired) {
         let _ = writeln!(h, "<h2>{}</h2>", esc(row.method));
@@ -264,68 +253,37 @@ fn metrics_table(m: &FairnessMetrics) -> String {
     s
 }
 
-/// The Markdown that `batten compare` prints (a caption line, a pipe table, numbered notes)
-/// as HTML: the caption and notes as paragraphs, the table as a `<table>` with the column
-/// alignment of its delimiter row.
-fn markdown_to_html(md: &str) -> String {
-    let cells = |line: &str| -> Vec<String> {
-        let inner = line.trim().trim_start_matches('|').trim_end_matches('|');
-        inner.split('|').map(|c| c.trim().to_string()).collect()
-    };
-    let mut out = String::new();
-    let mut table: Vec<Vec<String>> = Vec::new();
-    let mut notes: Vec<&str> = Vec::new();
-    let mut before_table = true;
-    for line in md.lines() {
-        let t = line.trim();
-        if t.starts_with('|') {
-            table.push(cells(t));
-            before_table = false;
-        } else if t.is_empty() {
-            continue;
-        } else if before_table {
-            let _ = writeln!(out, "<p>{}</p>", esc(t));
+/// The comparison table as HTML: the caption as a paragraph, the cells (escaped) in a
+/// `<table>` with the numbers aligned right, the notes as a numbered list.
+fn table_html(table: &Table) -> String {
+    let cell = |tag: &str, number: bool, text: &str| {
+        if number {
+            format!("<{tag} class=\"r\">{}</{tag}>", esc(text))
         } else {
-            notes.push(t);
+            format!("<{tag}>{}</{tag}>", esc(text))
         }
+    };
+    let mut out = format!(
+        "<p>{}</p>\n<table class=\"compare\">\n<tr>",
+        esc(&table.caption)
+    );
+    for (title, number) in COLUMNS {
+        out.push_str(&cell("th", number, title));
     }
-    if table.len() >= 2 {
-        let align: Vec<&str> = table[1]
-            .iter()
-            .map(|c| match (c.starts_with(':'), c.ends_with(':')) {
-                (true, true) => "c",
-                (false, true) => "r",
-                _ => "",
-            })
-            .collect();
-        let cell = |tag: &str, i: usize, text: &str| {
-            let class = align.get(i).copied().unwrap_or("");
-            if class.is_empty() {
-                format!("<{tag}>{}</{tag}>", esc(text))
-            } else {
-                format!("<{tag} class=\"{class}\">{}</{tag}>", esc(text))
-            }
-        };
-        out.push_str("<table class=\"compare\">\n<tr>");
-        for (i, c) in table[0].iter().enumerate() {
-            out.push_str(&cell("th", i, c));
+    out.push_str("</tr>\n");
+    for row in &table.rows {
+        out.push_str("<tr>");
+        for (text, (_, number)) in row.iter().zip(COLUMNS) {
+            out.push_str(&cell("td", number, text));
         }
         out.push_str("</tr>\n");
-        for row in &table[2..] {
-            out.push_str("<tr>");
-            for (i, c) in row.iter().enumerate() {
-                out.push_str(&cell("td", i, c));
-            }
-            out.push_str("</tr>\n");
-        }
-        out.push_str("</table>\n");
     }
-    if !notes.is_empty() {
+    out.push_str("</table>\n");
+    if !table.notes.is_empty() {
         out.push_str("<ol class=\"notes\">\n");
-        for n in notes {
-            // "[1] mst: ..." → the list numbers it.
-            let text = n.split_once("] ").map_or(n, |(_, rest)| rest);
-            let _ = writeln!(out, "<li>{}</li>", esc(text));
+        for note in &table.notes {
+            // Writing to a String cannot fail.
+            let _ = writeln!(out, "<li>{}</li>", esc(note));
         }
         out.push_str("</ol>\n");
     }
@@ -337,20 +295,18 @@ mod tests {
     use super::*;
 
     #[test]
-    fn markdown_table_becomes_html() {
-        let md = "a.csv: 4 points, open; tolerance none\n\n\
-                  | Method | Infl | time |\n| :-- | --: | --: |\n| input | 3 | – |\n\
-                  | mst [1] | 1 | 2 ms |\n\n[1] mst: run at <tolerance> 0.1\n";
-        let html = markdown_to_html(md);
-        assert!(html.starts_with("<p>a.csv: 4 points, open; tolerance none</p>\n"));
-        assert!(html.contains("<tr><th>Method</th><th class=\"r\">Infl</th>"));
+    fn the_table_becomes_html_cell_by_cell() {
+        let html = table_html(&compare::example_table());
+        assert!(html.starts_with(
+            "<p>a&lt;b&gt;.csv: 4 points, open; tolerance none</p>\n<table class=\"compare\">\n\
+             <tr><th>Method</th><th class=\"r\">Infl</th><th class=\"r\">Vib</th>"
+        ));
         assert!(
-            html.contains(
-                "<tr><td>mst [1]</td><td class=\"r\">1</td><td class=\"r\">2 ms</td></tr>"
-            )
+            html.contains("<tr><td>mst [1]</td><td class=\"r\">failed</td><td class=\"r\"></td>")
         );
-        assert!(html.contains("<li>mst: run at &lt;tolerance&gt; 0.1</li>"));
+        assert!(html.contains("<li>mst: failed: p &lt; 0 &amp; &quot;q&quot;</li>"));
         assert_eq!(html.matches("<tr>").count(), 3);
+        assert_eq!(html.matches("<td").count(), 14);
     }
 
     #[test]

@@ -5,33 +5,18 @@ use batten::fair::{self, EndFix, FairStatus, ToleranceSource};
 use batten::{FairOptions, Point, PointSeq};
 use proptest::prelude::*;
 
-/// A deterministic xorshift in [−0.5, 0.5).
-fn noise(seed: u64) -> impl FnMut() -> f64 {
-    let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-    move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    }
-}
+mod common;
+use common::{Noise, jitter};
 
-/// Samples of a wavy open curve, or of a closed trefoil-like loop, with a wobble of `amp`.
+/// Samples of a wavy open curve (`sin x` on [0, 6]), or of a closed three-lobed loop, with a
+/// uniform wobble of width `amp`.
 fn noisy(n: usize, amp: f64, seed: u64, closed: bool) -> PointSeq {
-    let mut r = noise(seed);
-    let pts: Vec<Point> = (0..n)
-        .map(|i| {
-            if closed {
-                let a = std::f64::consts::TAU * i as f64 / n as f64;
-                let rad = 1.0 + 0.2 * (3.0 * a).cos();
-                Point::new(rad * a.cos() + amp * r(), rad * a.sin() + amp * r())
-            } else {
-                let x = 6.0 * i as f64 / (n - 1) as f64;
-                Point::new(x + amp * r(), x.sin() + amp * r())
-            }
-        })
-        .collect();
-    PointSeq::new(pts, closed).expect("valid points")
+    let exact = if closed {
+        common::lobed_loop(n)
+    } else {
+        common::sine(n, 6.0)
+    };
+    PointSeq::new(jitter(&exact, Noise::Uniform(amp), seed), closed).expect("valid points")
 }
 
 /// The largest displacement, by the contract's own measure (`Point::distance`, a `hypot`): a
@@ -79,16 +64,13 @@ fn removes_the_wiggles_of_a_noisy_sine_within_the_tolerance() {
 /// RMS distance of the points of a faired `noisy(n, _, _, false)` to the exact sine at the
 /// same abscissae.
 fn rms_to_sine(points: &[Point]) -> f64 {
-    let n = points.len();
+    let exact = common::sine(points.len(), 6.0);
     let sum: f64 = points
         .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let x = 6.0 * i as f64 / (n - 1) as f64;
-            (p.x - x).powi(2) + (p.y - x.sin()).powi(2)
-        })
+        .zip(&exact)
+        .map(|(p, q)| (p.x - q.x).powi(2) + (p.y - q.y).powi(2))
         .sum();
-    (sum / n as f64).sqrt()
+    (sum / points.len() as f64).sqrt()
 }
 
 #[test]
@@ -125,17 +107,8 @@ fn the_debiasing_stage_moves_closer_to_the_truth_and_stays_fair() {
 /// (κ = 8) to its flat one (κ = 1/8), with uniform noise of half-width `amp`, and the exact
 /// points.
 fn noisy_quarter_ellipse(n: usize, amp: f64, seed: u64) -> (PointSeq, Vec<Point>) {
-    let mut r = noise(seed);
-    let exact: Vec<Point> = (0..n)
-        .map(|i| {
-            let t = std::f64::consts::FRAC_PI_2 * i as f64 / (n - 1) as f64;
-            Point::new(2.0 * t.cos(), 0.5 * t.sin())
-        })
-        .collect();
-    let pts = exact
-        .iter()
-        .map(|p| Point::new(p.x + amp * r(), p.y + amp * r()))
-        .collect();
+    let exact = common::ellipse_arc(n, 2.0, 0.5, std::f64::consts::FRAC_PI_2);
+    let pts = jitter(&exact, Noise::Uniform(amp), seed);
     (PointSeq::new(pts, false).expect("valid points"), exact)
 }
 
@@ -183,23 +156,10 @@ fn local_debiasing_restores_a_flattened_vertex() {
 }
 
 /// A noisy arc of the ellipse (2.8 cos t, sin t), t in [0, 1.3π], with Gaussian noise of
-/// `sigma` per coordinate (Box–Muller on the xorshift), and the exact points.
+/// `sigma` per coordinate, and the exact points.
 fn noisy_ellipse_arc(n: usize, sigma: f64, seed: u64) -> (PointSeq, Vec<Point>) {
-    let mut r = noise(seed);
-    let mut gauss = move || {
-        let (a, b) = (r() + 0.5, r() + 0.5);
-        (-2.0 * a.max(1e-300).ln()).sqrt() * (std::f64::consts::TAU * b).cos()
-    };
-    let exact: Vec<Point> = (0..n)
-        .map(|i| {
-            let t = 1.3 * std::f64::consts::PI * i as f64 / (n - 1) as f64;
-            Point::new(2.8 * t.cos(), t.sin())
-        })
-        .collect();
-    let pts = exact
-        .iter()
-        .map(|p| Point::new(p.x + sigma * gauss(), p.y + sigma * gauss()))
-        .collect();
+    let exact = common::ellipse_arc(n, 2.8, 1.0, 1.3 * std::f64::consts::PI);
+    let pts = jitter(&exact, Noise::Gaussian(sigma), seed);
     (PointSeq::new(pts, false).expect("valid points"), exact)
 }
 

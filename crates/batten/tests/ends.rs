@@ -8,26 +8,20 @@ use batten::spline::{BSplineCurve, Parametrization};
 use batten::{FairOptions, Point, PointSeq, Vec2};
 use proptest::prelude::*;
 
+mod common;
+
 /// The methods that move the points themselves.
 const POINT_METHODS: [&str; 5] = ["han", "mst", "kjellander", "poliakoff", "energy"];
 /// The methods that move the control points of a clamped cubic fitted to the points.
 const CONTROL_POINT_METHODS: [&str; 4] = ["sapidis-farin", "salvi", "eck-hadenfeld", "cali"];
 
-/// Samples of `sin(x)` on [0, 2π] with a deterministic wobble of `amp`.
+/// Samples of `sin(x)` on [0, 2π] with a uniform wobble of width `amp`.
 fn noisy_sine(n: usize, amp: f64, seed: u64) -> Vec<Point> {
-    let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-    let mut noise = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
-    (0..n)
-        .map(|i| {
-            let x = i as f64 * std::f64::consts::TAU / (n - 1) as f64;
-            Point::new(x + amp * noise(), x.sin() + amp * noise())
-        })
-        .collect()
+    common::jitter(
+        &common::sine(n, std::f64::consts::TAU),
+        common::Noise::Uniform(amp),
+        seed,
+    )
 }
 
 fn held_indices(n: usize, k: usize) -> impl Iterator<Item = usize> {

@@ -11,25 +11,8 @@ use batten::geom::{SpaceSeq, Xyz};
 use batten::{FairOptions, Point, PointSeq};
 use proptest::prelude::*;
 
-/// A deterministic xorshift in [−0.5, 0.5).
-fn noise(seed: u64) -> impl FnMut() -> f64 {
-    let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-    move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    }
-}
-
-/// A standard normal sample (Box–Muller on the xorshift).
-fn gaussian(seed: u64) -> impl FnMut() -> f64 {
-    let mut u = noise(seed);
-    move || {
-        let (a, b) = (u() + 0.5, u() + 0.5);
-        (-2.0 * a.max(1e-300).ln()).sqrt() * (std::f64::consts::TAU * b).cos()
-    }
-}
+mod common;
+use common::{Noise, Rng, jitter};
 
 /// The true curve: an open helix of two turns, or a closed (2, 3) torus knot.
 fn truth(n: usize, closed: bool) -> Vec<Xyz> {
@@ -50,8 +33,11 @@ fn truth(n: usize, closed: bool) -> Vec<Xyz> {
 /// The true curve with Gaussian noise of `sigma` per coordinate.
 fn noisy(n: usize, sigma: f64, seed: u64, closed: bool) -> (SpaceSeq, Vec<Xyz>) {
     let exact = truth(n, closed);
-    let mut g = gaussian(seed);
-    let pts = exact.iter().map(|p| p.map(|c| c + sigma * g())).collect();
+    let mut rng = Rng::new(seed);
+    let pts = exact
+        .iter()
+        .map(|p| p.map(|c| c + rng.sample(Noise::Gaussian(sigma))))
+        .collect();
     (SpaceSeq::new(pts, closed).expect("valid points"), exact)
 }
 
@@ -187,22 +173,14 @@ proptest! {
     }
 }
 
-/// A noisy planar curve.
+/// A noisy planar curve: `sin x` on [0, 6], or a closed three-lobed loop.
 fn planar(n: usize, closed: bool, seed: u64) -> PointSeq {
-    let mut g = gaussian(seed);
-    let pts: Vec<Point> = (0..n)
-        .map(|i| {
-            if closed {
-                let a = std::f64::consts::TAU * i as f64 / n as f64;
-                let r = 1.0 + 0.2 * (3.0 * a).cos();
-                Point::new(r * a.cos() + 0.01 * g(), r * a.sin() + 0.01 * g())
-            } else {
-                let x = 6.0 * i as f64 / (n - 1) as f64;
-                Point::new(x + 0.01 * g(), x.sin() + 0.01 * g())
-            }
-        })
-        .collect();
-    PointSeq::new(pts, closed).unwrap()
+    let exact = if closed {
+        common::lobed_loop(n)
+    } else {
+        common::sine(n, 6.0)
+    };
+    PointSeq::new(jitter(&exact, Noise::Gaussian(0.01), seed), closed).unwrap()
 }
 
 /// A planar curve at `z = 0` faired in 3-D gives the planar method's x and y (`mst` within

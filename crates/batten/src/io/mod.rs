@@ -13,6 +13,8 @@
 //!   [`write_atomic_set`] writes several files all or none; [`check_writable`] tells before
 //!   any work whether an output can be created; [`remove_temporaries`] cleans up on a signal.
 //! - [`ensure_distinct`] refuses an output path that is the input file.
+//! - [`format_sig`] rounds a number for people (tables and notes), where [`format_f64`]
+//!   writes it exactly.
 //!
 //! - [`parse_input`] / [`read_input`] read any format from bytes (standard input) or a file,
 //!   picking one curve of a file that holds several ([`Pick`]), into points or a B-spline
@@ -73,6 +75,7 @@ mod error;
 mod iges;
 mod json;
 mod limits;
+mod sig;
 mod surface;
 mod svg;
 mod text;
@@ -84,6 +87,7 @@ pub use atomic::{check_writable, remove_temporaries, write_atomic, write_atomic_
 pub use dxf::{DxfCurve, DxfDrawing, DxfGeometry};
 pub use error::{IoError, Location};
 pub use limits::MAX_COORDINATE;
+pub use sig::format_sig;
 pub use surface::{format_surface, parse_surface, read_surface_json, write_surface_json};
 pub use text::format_f64;
 
