@@ -610,8 +610,11 @@ proptest! {
             let sampled = max_dist(&c, &rem.curve, 4000);
             prop_assert!(sampled <= rem.max_deviation * (1.0 + 1e-9) + 1e-12,
                 "{:?}: sampled {:e} > reported {:e}", rule, sampled, rem.max_deviation);
+            // Reinsertion is exact but for rounding, which scales with the curve it works on:
+            // the removed one, whose control points a removal next to a multiple knot can
+            // blow up (a random case, kept as a seed: degree 5, Left, 2.6e7 from a curve of 5).
             let again = max_dist(&rem.reinserted, &rem.curve, 500);
-            prop_assert!(again <= 1e-9 * curve_scale(&c));
+            prop_assert!(again <= 1e-9 * curve_scale(&rem.curve));
             if matches!(rule, RemovalRule::Left | RemovalRule::Right | RemovalRule::Middle) {
                 prop_assert!(rem.changed.len() <= 1);
             }
