@@ -13,6 +13,9 @@ use batten::{Curve, Error, FairOptions, Point, PointSeq};
 use proptest::prelude::*;
 use serde_json::Value;
 
+mod common;
+use common::Rng;
+
 const VECTORS: &str = include_str!("data/test-vectors.json");
 
 fn vector(id: &str) -> Value {
@@ -58,26 +61,6 @@ fn assert_close(got: &[f64], exp: &[f64], tol: &Value, what: &str) {
     }
 }
 
-/// xorshift64 with Box–Muller normals: deterministic noise without a dependency.
-struct Rng(u64);
-
-impl Rng {
-    fn new(seed: u64) -> Rng {
-        Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
-    }
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn normal(&mut self) -> f64 {
-        let u1 = self.uniform().max(1e-300);
-        let u2 = self.uniform();
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-    }
-}
-
 /// A clamped uniform cubic with control points on `f`.
 fn cubic(n: usize, f: impl Fn(usize) -> Point) -> BSplineCurve {
     BSplineCurve::new(
@@ -102,8 +85,8 @@ fn perturbed(base: &BSplineCurve, sigma: f64, seed: u64) -> BSplineCurve {
     let mut pts = base.control_points().to_vec();
     let n = pts.len();
     for p in &mut pts[1..n - 1] {
-        p.x += sigma * rng.normal();
-        p.y += sigma * rng.normal();
+        p.x += sigma * rng.gaussian();
+        p.y += sigma * rng.gaussian();
     }
     base.with_control_points(pts).expect("finite")
 }
@@ -689,7 +672,7 @@ fn noisy_sine_points(n: usize, seed: u64) -> Vec<Point> {
     (0..n)
         .map(|i| {
             let x = i as f64 * 0.1;
-            Point::new(x, x.sin() + 0.01 * rng.normal())
+            Point::new(x, x.sin() + 0.01 * rng.gaussian())
         })
         .collect()
 }
