@@ -26,12 +26,12 @@
 //! # Writing
 //!
 //! A header `x,y` (`x,y,z`), then one row per point, with numbers in the shortest form that reads
-//! back to the same `f64` bit for bit (see [`format_f64`]).
+//! back to the same `f64` bit for bit (see [`super::format_f64`]).
 
-use std::fmt::Write as _;
 use std::path::Path;
 
 use super::IoError;
+use super::number::push_f64;
 use crate::geom::{Point, Xyz};
 
 /// Longest field text echoed in an error message, in characters.
@@ -315,30 +315,6 @@ fn echo(field: &str) -> String {
     out
 }
 
-/// The shortest decimal text that reads back (with `f64::from_str`) as exactly `x`.
-///
-/// Rust's `Display` for `f64` prints the shortest digit string that round-trips, but never
-/// in exponent form, so `1e300` would take 301 characters; `LowerExp` prints the same digits
-/// with an exponent. Numbers of magnitude in `[1e-5, 1e16)` (and zeros) use `Display`
-/// (`0.1`, `-2.5`, `-0`), all others `LowerExp` (`1e300`, `5e-324`). Both are exact.
-/// Non-finite values are the caller's to reject.
-pub fn format_f64(x: f64) -> String {
-    let mut s = String::new();
-    push_f64(&mut s, x);
-    s
-}
-
-/// [`format_f64`], appended to `out` without an intermediate string.
-pub(crate) fn push_f64(out: &mut String, x: f64) {
-    let a = x.abs();
-    // Writing to a String cannot fail.
-    let _ = if a == 0.0 || (1e-5..1e16).contains(&a) {
-        write!(out, "{x}")
-    } else {
-        write!(out, "{x:e}")
-    };
-}
-
 /// The text format of space points: header `x,y,z`, one row per point.
 pub(crate) fn format_space(points: &[Xyz]) -> String {
     let mut out = String::with_capacity(16 + points.len() * 60);
@@ -381,7 +357,10 @@ impl ParsedText {
 #[cfg(test)]
 #[allow(clippy::unwrap_used)]
 mod tests {
+    use std::fmt::Write as _;
+
     use super::*;
+    use crate::io::format_f64;
 
     fn parse_str(s: &str) -> Result<ParsedText, IoError> {
         parse(s.as_bytes(), Path::new("data.csv"))
