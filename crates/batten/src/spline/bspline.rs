@@ -374,7 +374,11 @@ pub(crate) fn basis_derivs(
         MAX_ORDER - 1
     );
     if nd == 0 {
-        basis_only(u, p, k, t, out);
+        // The cubic (every report's GFI interpolant) with its loop bounds known.
+        match p {
+            3 => basis_only(u, Cubic, k, t, out),
+            _ => basis_only(u, p, k, t, out),
+        }
         return;
     }
     let mut ndu = [[0.0; MAX_ORDER]; MAX_ORDER];
@@ -465,7 +469,8 @@ pub(crate) fn basis_derivs(
 /// (each level's values overwrite the level before, with the same zero-denominator guard), so
 /// the same bits, without the table and the derivative loops (the B-spline interpolant's
 /// collocation matrix, which the GFI of every report builds).
-fn basis_only(u: &[f64], p: usize, k: usize, t: f64, out: &mut [[f64; MAX_ORDER]; 4]) {
+fn basis_only(u: &[f64], p: impl Degree, k: usize, t: f64, out: &mut [[f64; MAX_ORDER]; 4]) {
+    let p = p.degree();
     let mut n = [0.0; MAX_ORDER];
     let mut left = [0.0; MAX_ORDER];
     let mut right = [0.0; MAX_ORDER];
@@ -486,6 +491,30 @@ fn basis_only(u: &[f64], p: usize, k: usize, t: f64, out: &mut [[f64; MAX_ORDER]
     out[0][..=p].copy_from_slice(&n[..=p]);
     for row in &mut out[1..] {
         *row = [0.0; MAX_ORDER];
+    }
+}
+
+/// A degree known at run time (`usize`) or at compile time ([`Cubic`]), so that one body of
+/// [`basis_only`] serves both.
+trait Degree: Copy {
+    fn degree(self) -> usize;
+}
+
+impl Degree for usize {
+    #[inline(always)]
+    fn degree(self) -> usize {
+        self
+    }
+}
+
+/// Degree 3, known at compile time.
+#[derive(Clone, Copy)]
+struct Cubic;
+
+impl Degree for Cubic {
+    #[inline(always)]
+    fn degree(self) -> usize {
+        3
     }
 }
 
