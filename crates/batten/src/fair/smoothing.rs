@@ -101,6 +101,12 @@ const GCV_LOG_ALPHA_TOL: f64 = 1e-4;
 /// Brent refinement of the GCV minimum: evaluation budget.
 const GCV_MAX_EVALUATIONS: usize = 60;
 
+/// The most memory the searches spend on keeping the data's part of every row of the system
+/// ([`KnotTerms`], 72 bytes a point in the plane) instead of making it again for each of
+/// their ~19 trials: 8 MiB, about 10⁵ points. Kept, the rows cost a third of a trial on a
+/// 200-point curve (issue #17); at 10⁶ points they would raise the peak memory by a third.
+const TERMS_CACHE_BYTES: usize = 8 << 20;
+
 /// How the smoothing parameter is chosen.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
@@ -542,9 +548,13 @@ impl<'a, const D: usize> Problem<'a, D> {
         })
     }
 
-    /// The problem with the [`KnotTerms`] of every unknown kept, for a search.
+    /// The problem with the [`KnotTerms`] of every unknown kept, for a search, when they
+    /// take at most [`TERMS_CACHE_BYTES`] (larger curves make them as each trial assembles
+    /// its matrix: the same numbers, without the memory).
     fn with_terms(mut self) -> Self {
-        self.terms = (0..self.m()).map(|j| self.knot_terms(j)).collect();
+        if self.m() * std::mem::size_of::<KnotTerms<D>>() <= TERMS_CACHE_BYTES {
+            self.terms = (0..self.m()).map(|j| self.knot_terms(j)).collect();
+        }
         self
     }
 
