@@ -140,22 +140,28 @@ mod tests {
         ]
     }
 
+    /// The m×m matrix with columns `column(j)` in the general band code.
+    fn sym_banded(m: usize, column: impl Fn(usize) -> [f64; 3]) -> SymBanded {
+        let mut general = SymBanded::zeros(m, 2);
+        for j in 0..m {
+            let [d0, d1, d2] = column(j);
+            general.add(j, j, d0);
+            if j + 1 < m {
+                general.add(j + 1, j, d1);
+            }
+            if j + 2 < m {
+                general.add(j + 2, j, d2);
+            }
+        }
+        general
+    }
+
     /// The same bits as the general band code, factors and solutions, for every small size
     /// (the first rows are special cases) and a large one.
     #[test]
     fn same_bits_as_sym_banded() {
         for m in (0..12).chain([257]) {
-            let mut general = SymBanded::zeros(m, 2);
-            for j in 0..m {
-                let [d0, d1, d2] = column(j);
-                general.add(j, j, d0);
-                if j + 1 < m {
-                    general.add(j + 1, j, d1);
-                }
-                if j + 2 < m {
-                    general.add(j + 2, j, d2);
-                }
-            }
+            let mut general = sym_banded(m, column);
             let mut penta = Penta::from_columns((0..m).map(column));
             general.factorize().unwrap();
             penta.factorize().unwrap();
@@ -194,18 +200,7 @@ mod tests {
             let [d0, d1, d2] = column(j);
             [if j == 5 { -d0 } else { d0 }, d1, d2]
         };
-        let mut general = SymBanded::zeros(m, 2);
-        for j in 0..m {
-            let [d0, d1, d2] = col(j);
-            general.add(j, j, d0);
-            if j + 1 < m {
-                general.add(j + 1, j, d1);
-            }
-            if j + 2 < m {
-                general.add(j + 2, j, d2);
-            }
-        }
-        let want = general.factorize().unwrap_err().to_string();
+        let want = sym_banded(m, col).factorize().unwrap_err().to_string();
         let got = Penta::from_columns((0..m).map(col))
             .factorize()
             .unwrap_err()

@@ -241,21 +241,8 @@ impl BSplineCurve {
         }
         let u = self.knots.as_slice();
         let q = p - 1;
-        let mut n = [0.0; MAX_ORDER];
-        let mut left = [0.0; MAX_ORDER];
-        let mut right = [0.0; MAX_ORDER];
-        n[0] = 1.0;
-        for j in 1..=q {
-            left[j] = t - u[k + 1 - j];
-            right[j] = u[k + j] - t;
-            let mut saved = 0.0;
-            for r in 0..j {
-                let temp = n[r] / (right[r + 1] + left[j - r]);
-                n[r] = saved + right[r + 1] * temp;
-                saved = left[j - r] * temp;
-            }
-            n[j] = saved;
-        }
+        // Every denominator of A2.2 spans the non-empty span k, so its 0/0 guard never acts.
+        let n = basis_functions(u, q, k, t);
         let mut d = Vec2::ZERO;
         for (r, nr) in n.iter().enumerate().take(q + 1) {
             let i = k - q + r;
@@ -464,12 +451,21 @@ pub(crate) fn basis_derivs(
     }
 }
 
-/// [`basis_derivs`] without derivatives (Piegl & Tiller A2.2): the basis functions into
-/// `out[0]`, the other rows zero. The same operations as the upper triangle of A2.3's table
-/// (each level's values overwrite the level before, with the same zero-denominator guard), so
-/// the same bits, without the table and the derivative loops (the B-spline interpolant's
-/// collocation matrix, which the GFI of every report builds).
+/// [`basis_derivs`] without derivatives: [`basis_functions`] into `out[0]`, the other rows
+/// zero. The same operations as the upper triangle of A2.3's table, so the same bits, without
+/// the table and the derivative loops (the B-spline interpolant's collocation matrix, which
+/// the GFI of every report builds).
 fn basis_only(u: &[f64], p: impl Degree, k: usize, t: f64, out: &mut [[f64; MAX_ORDER]; 4]) {
+    out[0] = basis_functions(u, p, k, t);
+    for row in &mut out[1..] {
+        *row = [0.0; MAX_ORDER];
+    }
+}
+
+/// The non-zero basis functions `N_{k−p..=k, p}` at `t` in span `k` (Piegl & Tiller A2.2,
+/// 0/0 := 0 for repeated knots), the rest of the array zero: each level's values overwrite
+/// the level before.
+fn basis_functions(u: &[f64], p: impl Degree, k: usize, t: f64) -> [f64; MAX_ORDER] {
     let p = p.degree();
     let mut n = [0.0; MAX_ORDER];
     let mut left = [0.0; MAX_ORDER];
@@ -487,11 +483,7 @@ fn basis_only(u: &[f64], p: impl Degree, k: usize, t: f64, out: &mut [[f64; MAX_
         }
         n[j] = saved;
     }
-    out[0] = [0.0; MAX_ORDER];
-    out[0][..=p].copy_from_slice(&n[..=p]);
-    for row in &mut out[1..] {
-        *row = [0.0; MAX_ORDER];
-    }
+    n
 }
 
 /// A degree known at run time (`usize`) or at compile time ([`Cubic`]), so that one body of
