@@ -22,12 +22,14 @@ const DIGITS: usize = 6;
 /// # Errors
 /// Bad input (exit 2); a metric that cannot be computed (exit 1).
 pub fn run(args: &AnalyzeArgs) -> Result<ExitCode, Failure> {
-    let read = input::read_points_any(&args.input, args.closed, &args.pick)?;
     let name = formats::display_name(&args.input).display().to_string();
+    // One spinner from the start: reading 10⁷ points takes seconds too.
+    let spinner = Spinner::start(format!("reading {name}"));
+    let read = input::read_points_any(&args.input, args.closed, &args.pick)?;
     let failed = |e| Failure::from_batten(&format!("{name}: cannot analyse"), e);
     let text = match read {
         input::Points::Planar(data) => {
-            let spinner = Spinner::start(format!("analysing {} points", data.seq.len()));
+            spinner.set_message(format!("analysing {} points", data.seq.len()));
             let metrics = FairnessMetrics::of_seq(&data.seq).map_err(failed)?;
             spinner.finish();
             if args.json {
@@ -37,7 +39,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<ExitCode, Failure> {
             }
         }
         input::Points::Space(data) => {
-            let spinner = Spinner::start(format!("analysing {} points", data.seq.len()));
+            spinner.set_message(format!("analysing {} points", data.seq.len()));
             let metrics = SpaceMetrics::of_seq(&data.seq).map_err(failed)?;
             spinner.finish();
             if args.json {

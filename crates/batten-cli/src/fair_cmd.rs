@@ -83,12 +83,16 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
 
     // A B-spline (JSON, DXF SPLINE, IGES 126, SVG Béziers) is faired as a curve
     // (control-point methods only); a space curve by the methods that take one.
+    // One spinner from the start: reading 10⁷ points takes seconds too.
+    let spinner = Spinner::start(format!("reading {}", input_name.display()));
     let read = formats::read_input(&args.input, in_format, args.closed, &args.pick.pick())?;
     let origin = read.origin;
     let source = match read.source {
         io::Source::Points(d) => Source::Points(d),
         io::Source::Curve(c) => Source::Curve(c),
         io::Source::Space(d) => {
+            // The space command keeps its own spinner.
+            drop(spinner);
             check_distinct(args, to_stdout)?;
             return crate::fair_space_cmd::run(args, method, &options, &d, &origin, out_format);
         }
@@ -119,7 +123,7 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
     let input_name = input_name.display();
     let failed =
         |e| Failure::from_batten(&format!("{input_name}: method {} failed", method.name()), e);
-    let spinner = Spinner::start(format!("fairing with {}", method.name()));
+    spinner.set_message(format!("fairing with {}", method.name()));
     let faired = match &source {
         Source::Curve(curve) => fair::fair_curve(method.name(), curve, &options).map_err(failed)?,
         Source::Points(d) => fair::fair_with(method, &d.seq, &options).map_err(failed)?,

@@ -5,7 +5,7 @@
 use std::io::IsTerminal as _;
 use std::sync::mpsc::{self, RecvTimeoutError, Sender};
 use std::thread::JoinHandle;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
@@ -14,10 +14,18 @@ pub const SHOW_AFTER: Duration = Duration::from_secs(1);
 /// Redraw interval of a visible spinner.
 const TICK: Duration = Duration::from_millis(120);
 
+/// What the spinner's thread is told.
+enum Signal {
+    /// Show this message from now on.
+    Message(String),
+    /// The work is done: clear the spinner.
+    Done,
+}
+
 /// A running spinner; dropping it (or [`Spinner::finish`]) clears it.
 #[derive(Debug)]
 pub struct Spinner {
-    done: Option<Sender<()>>,
+    signals: Option<Sender<Signal>>,
     thread: Option<JoinHandle<()>>,
 }
 
@@ -26,14 +34,21 @@ impl Spinner {
     pub fn start(message: String) -> Spinner {
         if !std::io::stderr().is_terminal() {
             return Spinner {
-                done: None,
+                signals: None,
                 thread: None,
             };
         }
-        let (done, wait) = mpsc::channel::<()>();
+        let (signals, wait) = mpsc::channel::<Signal>();
         let thread = std::thread::spawn(move || {
-            if wait.recv_timeout(SHOW_AFTER) != Err(RecvTimeoutError::Timeout) {
-                return; // finished (or dropped) in time
+            let show_at = Instant::now() + SHOW_AFTER;
+            let mut message = message;
+            loop {
+                match wait.recv_timeout(show_at.saturating_duration_since(Instant::now())) {
+                    Ok(Signal::Message(m)) => message = m,
+                    Err(RecvTimeoutError::Timeout) => break,
+                    // Finished (or dropped) in time.
+                    Ok(Signal::Done) | Err(RecvTimeoutError::Disconnected) => return,
+                }
             }
             let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
             if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} [{elapsed}]") {
@@ -41,12 +56,22 @@ impl Spinner {
             }
             bar.set_message(message);
             bar.enable_steady_tick(TICK);
-            let _ = wait.recv();
+            while let Ok(Signal::Message(m)) = wait.recv() {
+                bar.set_message(m);
+            }
             bar.finish_and_clear();
         });
         Spinner {
-            done: Some(done),
+            signals: Some(signals),
             thread: Some(thread),
+        }
+    }
+
+    /// Show `message` from now on (the clock keeps running: a long read followed by a long
+    /// computation shows one spinner after [`SHOW_AFTER`], not one per step).
+    pub fn set_message(&self, message: String) {
+        if let Some(signals) = &self.signals {
+            let _ = signals.send(Signal::Message(message));
         }
     }
 
@@ -56,8 +81,8 @@ impl Spinner {
 
 impl Drop for Spinner {
     fn drop(&mut self) {
-        if let Some(done) = self.done.take() {
-            let _ = done.send(());
+        if let Some(signals) = self.signals.take() {
+            let _ = signals.send(Signal::Done);
         }
         if let Some(thread) = self.thread.take() {
             let _ = thread.join();

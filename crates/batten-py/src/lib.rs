@@ -29,7 +29,7 @@ use rayon::prelude::*;
 
 use crate::bspline::BSpline;
 use crate::errors::FairError;
-use crate::options::{Input, Request};
+use crate::options::{Input, Refused, Request};
 use crate::result::FairResult;
 
 /// Fair one curve; see the package docs (`batten.fair`).
@@ -71,14 +71,45 @@ fn fair_many(
     params: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Vec<FairResult>> {
     let request = Request::new(method, tolerance, fix_ends, max_iterations, closed, params)?;
-    let mut inputs: Vec<Input> = Vec::new();
+    // Read every curve (with Python), then validate them all (without it, in parallel), and
+    // raise the first problem in the list's order, as one loop reading and validating each
+    // curve in turn would.
+    let mut reads = Vec::new();
+    let mut unread = None;
     for (i, obj) in curves.try_iter()?.enumerate() {
-        let obj = obj?;
-        inputs.push(
+        match obj.and_then(|obj| {
             request
-                .input(&obj, closed)
-                .map_err(|e| errors::prefixed(py, &format!("curves[{i}]"), e))?,
-        );
+                .read(&obj, closed)
+                .map_err(|e| errors::prefixed(py, &format!("curves[{i}]"), e))
+        }) {
+            Ok(read) => reads.push(read),
+            Err(e) => {
+                unread = Some(e);
+                break;
+            }
+        }
+    }
+    let checked: Vec<Result<Input, Refused>> = py.detach(|| {
+        reads
+            .into_par_iter()
+            .map(|read| request.validate(read, closed))
+            .collect()
+    });
+    let mut inputs: Vec<Input> = Vec::with_capacity(checked.len());
+    for (i, input) in checked.into_iter().enumerate() {
+        match input {
+            Ok(input) => inputs.push(input),
+            Err(refused) => {
+                return Err(errors::prefixed(
+                    py,
+                    &format!("curves[{i}]"),
+                    refused.to_py(),
+                ));
+            }
+        }
+    }
+    if let Some(e) = unread {
+        return Err(e);
     }
     let outcomes: Vec<Result<options::Output, batten::Error>> =
         py.detach(|| inputs.par_iter().map(|input| request.run(input)).collect());

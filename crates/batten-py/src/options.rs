@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 use batten::fair::{self, EndFix, FairMethod, FairedSpace};
 use batten::spline::BSplineCurve;
-use batten::{FairOptions, Faired, PointSeq, SpaceSeq};
+use batten::{FairOptions, Faired, Point, PointSeq, SpaceSeq, Xyz};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyString};
 
@@ -38,6 +38,33 @@ pub enum Input {
     Curve(BSplineCurve),
     /// A validated space curve (`band`, `mst`).
     Space(SpaceSeq),
+}
+
+/// An input as read from Python, before the checks that need no Python
+/// ([`Request::validate`]).
+#[derive(Debug)]
+pub enum Read {
+    /// A B-spline curve (checked against the method already).
+    Curve(BSplineCurve),
+    /// Planar points, not yet validated.
+    Planar(Vec<Point>),
+    /// Space points, not yet validated.
+    Space(Vec<Xyz>),
+}
+
+/// Why [`Request::validate`] refused an input: the library's error and the prefix of its
+/// message.
+#[derive(Debug)]
+pub struct Refused {
+    what: &'static str,
+    error: batten::Error,
+}
+
+impl Refused {
+    /// The Python exception, as [`Request::input`] raises it.
+    pub fn to_py(&self) -> PyErr {
+        errors::library(self.what, &self.error)
+    }
 }
 
 /// What a run gives: a planar result (points or B-spline input) or a space curve's.
@@ -101,6 +128,12 @@ impl Request {
     /// Read `obj` as the request's input: a [`BSpline`], an `(n, 2)` array-like of points,
     /// or an `(n, 3)` one (a space curve, for the methods that fair one).
     pub fn input(&self, obj: &Bound<'_, PyAny>, closed: bool) -> PyResult<Input> {
+        self.validate(self.read(obj, closed)?, closed)
+            .map_err(|refused| refused.to_py())
+    }
+
+    /// The part of [`Request::input`] that needs Python: `obj` converted, not yet validated.
+    pub fn read(&self, obj: &Bound<'_, PyAny>, closed: bool) -> PyResult<Read> {
         if let Ok(b) = obj.cast::<BSpline>() {
             if closed {
                 return Err(errors::value(
@@ -120,20 +153,31 @@ impl Request {
                     takes.join(", ")
                 )));
             }
-            return Ok(Input::Curve(b.get().curve().clone()));
+            return Ok(Read::Curve(b.get().curve().clone()));
         }
-        match convert::points_any(obj, "points")? {
-            convert::Points::Planar(points) => {
-                let seq =
-                    PointSeq::new(points, closed).map_err(|e| errors::library("points", &e))?;
-                Ok(Input::Points(seq))
-            }
-            convert::Points::Space(points) => {
-                fair::check_space_method(self.method.name())
-                    .map_err(|e| errors::library("", &e))?;
-                let seq =
-                    SpaceSeq::new(points, closed).map_err(|e| errors::library("points", &e))?;
-                Ok(Input::Space(seq))
+        Ok(match convert::points_any(obj, "points")? {
+            convert::Points::Planar(points) => Read::Planar(points),
+            convert::Points::Space(points) => Read::Space(points),
+        })
+    }
+
+    /// The part of [`Request::input`] that needs no Python (so `fair_many` runs it on every
+    /// curve in parallel): the points validated as the CLI validates a file's.
+    ///
+    /// # Errors
+    /// [`Refused`], for [`Refused::to_py`].
+    pub fn validate(&self, read: Read, closed: bool) -> Result<Input, Refused> {
+        let refused = |what, error| Refused { what, error };
+        match read {
+            Read::Curve(curve) => Ok(Input::Curve(curve)),
+            Read::Planar(points) => PointSeq::new(points, closed)
+                .map(Input::Points)
+                .map_err(|e| refused("points", e)),
+            Read::Space(points) => {
+                fair::check_space_method(self.method.name()).map_err(|e| refused("", e))?;
+                SpaceSeq::new(points, closed)
+                    .map(Input::Space)
+                    .map_err(|e| refused("points", e))
             }
         }
     }

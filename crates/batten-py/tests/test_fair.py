@@ -196,6 +196,13 @@ def test_fair_many_names_the_bad_curve():
     near[5] = near[4] + 1e-15
     with pytest.raises(ValueError, match=r"^curves\[1\]: .*closer than"):
         batten.fair_many([noisy_sine(), near], method="mst")
+    # The first bad curve in the list's order, whether it fails as an array (read with
+    # Python) or as points (validated in parallel without it).
+    bad_array = np.zeros((4, 5))
+    with pytest.raises(ValueError, match=r"^curves\[1\]: .*closer than"):
+        batten.fair_many([noisy_sine(), near, bad_array, near], method="mst")
+    with pytest.raises(ValueError, match=r"^curves\[1\]: points: expected an \(n, 2\) array"):
+        batten.fair_many([noisy_sine(), bad_array, near], method="mst")
 
 
 def test_fair_many_releases_the_gil():

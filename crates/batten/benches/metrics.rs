@@ -10,21 +10,9 @@ mod common;
 
 use std::hint::black_box;
 
-use batten::{FairnessMetrics, Point, PointSeq};
-use common::{noisy_spiral, normal_noise};
+use batten::{FairnessMetrics, PointSeq};
+use common::{noisy_sine, noisy_spiral};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-
-/// `n` points of `y = sin(x)`, x in [0, 6], y moved by 0.005 times [`normal_noise`]: the
-/// curves of `bench/python_speed.py`.
-fn noisy_sine(n: usize) -> Vec<Point> {
-    let mut noise = normal_noise();
-    (0..n)
-        .map(|i| {
-            let x = 6.0 * i as f64 / (n - 1) as f64;
-            Point::new(x, x.sin() + 0.005 * noise())
-        })
-        .collect()
-}
 
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("metrics");

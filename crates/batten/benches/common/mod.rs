@@ -37,3 +37,15 @@ pub fn noisy_spiral(n: usize, turns: f64, wobble: f64) -> Vec<Point> {
         })
         .collect()
 }
+
+/// `n` points of `y = sin(x)`, x in [0, 6], y moved by 0.005 times [`normal_noise`]: the
+/// curves of `bench/python_speed.py`.
+pub fn noisy_sine(n: usize) -> Vec<Point> {
+    let mut noise = normal_noise();
+    (0..n)
+        .map(|i| {
+            let x = 6.0 * i as f64 / (n - 1) as f64;
+            Point::new(x, x.sin() + 0.005 * noise())
+        })
+        .collect()
+}

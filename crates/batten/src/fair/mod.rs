@@ -29,6 +29,8 @@ pub mod salvi;
 pub mod sapidis_farin;
 pub mod smoothing;
 mod smoothing_mst;
+mod smoothing_system;
+mod smoothing_trial;
 mod space;
 
 use std::time::Instant;

@@ -65,6 +65,9 @@
 
 use super::FairOptions;
 pub use super::smoothing_mst::{Mst, p_at_scale};
+use super::smoothing_system::Penta;
+pub(crate) use super::smoothing_trial::roughness;
+use super::smoothing_trial::{dot, max_displacement};
 use crate::error::{Error, Result};
 use crate::geom::{Point, Vec2};
 use crate::numeric::{CyclicSymBanded, SymBanded, factorize_with_inverse_band, minimize_brent};
@@ -97,6 +100,12 @@ const GCV_LOG_ALPHA_TOL: f64 = 1e-4;
 
 /// Brent refinement of the GCV minimum: evaluation budget.
 const GCV_MAX_EVALUATIONS: usize = 60;
+
+/// The most memory the searches spend on keeping the data's part of every row of the system
+/// ([`KnotTerms`], 72 bytes a point in the plane) instead of making it again for each of
+/// their ~19 trials: 8 MiB, about 10⁵ points. Kept, the rows cost a third of a trial on a
+/// 200-point curve (issue #17); at 10⁶ points they would raise the peak memory by a third.
+const TERMS_CACHE_BYTES: usize = 8 << 20;
 
 /// How the smoothing parameter is chosen.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -357,21 +366,10 @@ pub(crate) fn select_any<const D: usize>(
                     reason: format!("must be a positive finite number, got {tolerance}"),
                 });
             }
-            problem.search_tolerance(tolerance, max_steps)
+            problem.with_terms().search_tolerance(tolerance, max_steps)
         }
-        Smoothing::Gcv => problem.search_gcv(),
+        Smoothing::Gcv => problem.with_terms().search_gcv(),
     }
-}
-
-/// `a · b` (in 2-D as [`Vec2::dot`], bit for bit).
-fn dot<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
-    (1..D).fold(a[0] * b[0], |s, k| s + a[k] * b[k])
-}
-
-/// The distance `|a − b|` by `hypot`, as the fairing report measures it (in 2-D
-/// [`Point::distance`] bit for bit).
-fn distance<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
-    (1..D).fold((b[0] - a[0]).abs(), |s, k| s.hypot(b[k] - a[k]))
 }
 
 /// Solve for each coordinate of `rhs` in turn with `solve` (one factorisation, a scalar
@@ -391,14 +389,6 @@ fn by_coordinate<const D: usize>(
         }
     }
     Ok(())
-}
-
-/// The largest `|g_i − y_i|`, measured as the fairing report measures it.
-fn max_displacement<const D: usize>(y: &[[f64; D]], g: &[[f64; D]]) -> f64 {
-    y.iter()
-        .zip(g)
-        .map(|(a, b)| distance(a, b))
-        .fold(0.0, f64::max)
 }
 
 /// `α = (1 − p)/p`.
@@ -431,18 +421,6 @@ pub(crate) fn check_p(p: f64, closed: bool) -> Result<()> {
     Ok(())
 }
 
-/// `∫ |C''|² dt` for C'' piecewise linear through `second` at the knots `t`.
-pub(crate) fn roughness<const D: usize>(t: &[f64], second: &[[f64; D]], closed: bool) -> f64 {
-    let n = second.len();
-    let spans = if closed { n } else { n.saturating_sub(1) };
-    (0..spans)
-        .map(|i| {
-            let (a, b) = (&second[i], &second[(i + 1) % n]);
-            (t[i + 1] - t[i]) * (dot(a, a) + dot(a, b) + dot(b, b)) / 3.0
-        })
-        .sum()
-}
-
 /// One solved spline: the fitted values, `u` (with `γ = p·u`) at every knot, and the
 /// quantities the searches need.
 pub(crate) struct Fit<const D: usize> {
@@ -468,6 +446,44 @@ struct Problem<'a, const D: usize> {
     dinv: Option<Vec<f64>>,
     /// Reciprocal span lengths `1/h_k`: n − 1 (open) or n (closed).
     ih: Vec<f64>,
+    /// [`KnotTerms`] of every unknown, for the searches, which solve many times (empty for
+    /// one solve: they are then made as the matrix is assembled).
+    terms: Vec<KnotTerms<D>>,
+}
+
+/// What row `j` of the system takes from the data, whatever p: `Qᵀ y` and the parts of the
+/// entries of `a R + b Qᵀ W⁻¹ Q` (see [`KnotTerms::entries`]). Computed once per search
+/// instead of once per trial.
+#[derive(Clone, Copy, Debug)]
+struct KnotTerms<const D: usize> {
+    /// `(Qᵀ y)` at the knot.
+    qty: [f64; D],
+    /// `h_{k−1} + h_k`.
+    span_sum: f64,
+    /// `h_k`.
+    span: f64,
+    /// `1/h_k`.
+    ih: f64,
+    /// `1/h_{k+1}` (0 when span k+1 does not exist).
+    ih_next: f64,
+    /// `W⁻¹` at knot k + 1.
+    d_next: f64,
+    /// The diagonal's data part, `W⁻¹_{k−1}/h²_{k−1} + W⁻¹_k (1/h_{k−1} + 1/h_k)² + W⁻¹_{k+1}/h²_k`.
+    data_diag: f64,
+    /// The first off-diagonal's data part over `1/h_k`.
+    data_next: f64,
+}
+
+impl<const D: usize> KnotTerms<D> {
+    /// The entries `(k,k)`, `(k,k+1)`, `(k,k+2)` of `a R + b Qᵀ W⁻¹ Q`, in the order of
+    /// operations they have always been computed in (so the same bits).
+    #[inline]
+    fn entries(&self, a: f64, b: f64) -> [f64; 3] {
+        let d0 = a * self.span_sum / 3.0 + b * self.data_diag;
+        let d1 = a * self.span / 6.0 - b * self.ih * self.data_next;
+        let d2 = b * self.d_next * self.ih * self.ih_next;
+        [d0, d1, d2]
+    }
 }
 
 impl<'a, const D: usize> Problem<'a, D> {
@@ -528,7 +544,52 @@ impl<'a, const D: usize> Problem<'a, D> {
             closed,
             dinv,
             ih,
+            terms: Vec::new(),
         })
+    }
+
+    /// The problem with the [`KnotTerms`] of every unknown kept, for a search, when they
+    /// take at most [`TERMS_CACHE_BYTES`] (larger curves make them as each trial assembles
+    /// its matrix: the same numbers, without the memory).
+    fn with_terms(mut self) -> Self {
+        if self.m() * std::mem::size_of::<KnotTerms<D>>() <= TERMS_CACHE_BYTES {
+            self.terms = (0..self.m()).map(|j| self.knot_terms(j)).collect();
+        }
+        self
+    }
+
+    /// The [`KnotTerms`] of unknown `j`: kept, or made now.
+    #[inline]
+    fn terms_of(&self, j: usize) -> KnotTerms<D> {
+        self.terms
+            .get(j)
+            .copied()
+            .unwrap_or_else(|| self.knot_terms(j))
+    }
+
+    /// The [`KnotTerms`] of unknown `j` from the data.
+    fn knot_terms(&self, j: usize) -> KnotTerms<D> {
+        let k = self.knot(j);
+        let (km, kp) = (self.prev(k), self.next(k));
+        let (ihm, ihp) = (self.ih[km], self.ih[k]);
+        let s = ihm + ihp;
+        let (dm, d, dp) = (self.d(km), self.d(k), self.d(kp));
+        // Span k+1 exists whenever knot k+1 is an unknown.
+        let ihpp = if self.closed || kp < self.n() - 1 {
+            self.ih[kp]
+        } else {
+            0.0
+        };
+        KnotTerms {
+            qty: self.qty(k),
+            span_sum: self.span(km) + self.span(k),
+            span: self.span(k),
+            ih: ihp,
+            ih_next: ihpp,
+            d_next: dp,
+            data_diag: dm * ihm * ihm + d * s * s + dp * ihp * ihp,
+            data_next: d * s + dp * (ihp + ihpp),
+        }
     }
 
     /// `W⁻¹_ii`.
@@ -602,26 +663,6 @@ impl<'a, const D: usize> Problem<'a, D> {
         }
     }
 
-    /// The entries `(k,k)`, `(k,k+1)`, `(k,k+2)` of `a R + b Qᵀ W⁻¹ Q` at knot k.
-    #[inline]
-    fn entries(&self, k: usize, a: f64, b: f64) -> [f64; 3] {
-        let (km, kp) = (self.prev(k), self.next(k));
-        let (ihm, ihp) = (self.ih[km], self.ih[k]);
-        let s = ihm + ihp;
-        let (dm, d, dp) = (self.d(km), self.d(k), self.d(kp));
-        let d0 = a * (self.span(km) + self.span(k)) / 3.0
-            + b * (dm * ihm * ihm + d * s * s + dp * ihp * ihp);
-        // Span k+1 exists whenever knot k+1 is an unknown.
-        let ihpp = if self.closed || kp < self.n() - 1 {
-            self.ih[kp]
-        } else {
-            0.0
-        };
-        let d1 = a * self.span(k) / 6.0 - b * ihp * (d * s + dp * (ihp + ihpp));
-        let d2 = b * dp * ihp * ihpp;
-        [d0, d1, d2]
-    }
-
     /// Solve for `p ∈ [0, 1]` (p = 0 by the least-squares line on open curves).
     fn fit_p(&self, p: f64) -> Result<Fit<D>> {
         if p == 0.0 {
@@ -648,8 +689,9 @@ impl<'a, const D: usize> Problem<'a, D> {
         if self.closed {
             let mut mat = CyclicSymBanded::zeros(m, 2);
             for (k, uk) in u.iter_mut().enumerate() {
-                *uk = self.qty(k);
-                let [d0, d1, d2] = self.entries(k, a, b);
+                let terms = self.terms_of(k);
+                *uk = terms.qty;
+                let [d0, d1, d2] = terms.entries(a, b);
                 mat.add(k, k, d0);
                 mat.add(k, (k + 1) % m, d1);
                 mat.add(k, (k + 2) % m, d2);
@@ -661,11 +703,12 @@ impl<'a, const D: usize> Problem<'a, D> {
                 mat.factorize()?;
             }
             by_coordinate(&mut u, |c| mat.solve_in_place(c))?;
-        } else {
+        } else if gcv {
             let mut mat = SymBanded::zeros(m, 2);
             for j in 0..m {
-                u[j + 1] = self.qty(j + 1);
-                let [d0, d1, d2] = self.entries(j + 1, a, b);
+                let terms = self.terms_of(j);
+                u[j + 1] = terms.qty;
+                let [d0, d1, d2] = terms.entries(a, b);
                 mat.add(j, j, d0);
                 if j + 1 < m {
                     mat.add(j + 1, j, d1);
@@ -674,18 +717,32 @@ impl<'a, const D: usize> Problem<'a, D> {
                     mat.add(j + 2, j, d2);
                 }
             }
-            if gcv {
-                let inv = factorize_with_inverse_band(&mut mat)?;
-                trace_residual = b * self.trace_term(|i, j| inv.get(i - 1, j - 1));
-            } else {
-                mat.factorize()?;
-            }
+            let inv = factorize_with_inverse_band(&mut mat)?;
+            trace_residual = b * self.trace_term(|i, j| inv.get(i - 1, j - 1));
             by_coordinate(&mut u[1..n - 1], |c| mat.solve_in_place(c))?;
+        } else {
+            // The same entries and operations as the band code above, written out for
+            // half-bandwidth 2 (see `smoothing_system`).
+            let row = |terms: &KnotTerms<D>, uj: &mut [f64; D]| {
+                *uj = terms.qty;
+                terms.entries(a, b)
+            };
+            let interior = u[1..n - 1].iter_mut();
+            let mut mat = if self.terms.is_empty() {
+                Penta::from_columns(
+                    interior
+                        .enumerate()
+                        .map(|(j, uj)| row(&self.knot_terms(j), uj)),
+                )
+            } else {
+                Penta::from_columns(self.terms.iter().zip(interior).map(|(t, uj)| row(t, uj)))
+            };
+            mat.factorize()?;
+            mat.solve_in_place(&mut u[1..n - 1]);
         }
         let mut values = Vec::with_capacity(n);
         let mut rss = 0.0;
-        for i in 0..n {
-            let qu = self.q_row_times(&u, i);
+        let mut push = |i: usize, qu: [f64; D]| {
             let di = self.d(i);
             let yi = self.y[i];
             values.push(std::array::from_fn(|c| yi[c] - qu[c] * (b * di)));
@@ -693,6 +750,25 @@ impl<'a, const D: usize> Problem<'a, D> {
                 // w_i |y_i − g_i|² = b² D_i |(Qu)_i|², exact even where g_i ≈ y_i.
                 rss += b * b * di * dot(&qu, &qu);
             }
+        };
+        if self.closed {
+            for i in 0..n {
+                push(i, self.q_row_times(&u, i));
+            }
+        } else {
+            // `q_row_times` for open curves, with the end terms apart (the same operations).
+            let ih = &self.ih;
+            push(0, std::array::from_fn(|c| (u[1][c] - u[0][c]) * ih[0]));
+            for (k, (w, h)) in u.windows(3).zip(ih.windows(2)).enumerate() {
+                let qu = std::array::from_fn(|c| {
+                    (w[0][c] - w[1][c]) * h[0] + (w[2][c] - w[1][c]) * h[1]
+                });
+                push(k + 1, qu);
+            }
+            push(
+                n - 1,
+                std::array::from_fn(|c| (u[n - 2][c] - u[n - 1][c]) * ih[n - 2]),
+            );
         }
         for v in &mut u {
             for c in v.iter_mut() {
@@ -709,22 +785,14 @@ impl<'a, const D: usize> Problem<'a, D> {
         })
     }
 
-    /// `(Q v)_i` for `v` given at every knot (zero at the open ends).
+    /// `(Q v)_i` of a closed curve, for `v` given at every knot (open curves: in
+    /// [`Problem::solve`], the ends apart).
     #[inline]
     fn q_row_times(&self, v: &[[f64; D]], i: usize) -> [f64; D] {
-        let n = self.n();
         let ih = &self.ih;
         let term = |j: usize, h: usize, c: usize| (v[j][c] - v[i][c]) * ih[h];
-        if self.closed {
-            let (im, ip) = (self.prev(i), self.next(i));
-            std::array::from_fn(|c| term(im, im, c) + term(ip, i, c))
-        } else if i == 0 {
-            std::array::from_fn(|c| term(1, 0, c))
-        } else if i == n - 1 {
-            std::array::from_fn(|c| term(i - 1, i - 1, c))
-        } else {
-            std::array::from_fn(|c| term(i - 1, i - 1, c) + term(i + 1, i, c))
-        }
+        let (im, ip) = (self.prev(i), self.next(i));
+        std::array::from_fn(|c| term(im, im, c) + term(ip, i, c))
     }
 
     /// `Σ_i W⁻¹_ii q_iᵀ M⁻¹ q_i` with `M⁻¹` read by knot indices through `inv` (only pairs of
@@ -887,16 +955,22 @@ impl<'a, const D: usize> Problem<'a, D> {
         Ok((fit, info))
     }
 
-    /// Tolerance mode: bisection on `ln α` for the largest feasible α.
+    /// Tolerance mode: bisection on `ln α` for the largest feasible α. Each solved trial is
+    /// measured once ([`Problem::trial`]), and its largest displacement decides.
     fn search_tolerance(self, tolerance: f64, max_steps: usize) -> Result<(Fit<D>, SmoothingInfo)> {
         let mut trials = Vec::new();
         let mut notes = Vec::new();
+        // A solved trial, recorded; whether it is within the tolerance.
+        let record = |fit: &Fit<D>, trials: &mut Vec<SmoothingTrial>| {
+            let trial = self.trial(fit, None);
+            trials.push(trial);
+            trial.max_displacement <= tolerance
+        };
         // The smoothest candidate of an open curve: the least-squares line.
         if !self.closed {
             match self.fit_line() {
                 Ok(line) => {
-                    trials.push(self.trial(&line, None));
-                    if max_displacement(self.y, &line.values) <= tolerance {
+                    if record(&line, &mut trials) {
                         notes.push("the least-squares line is within the tolerance".into());
                         return self.finish(line, trials, true, notes);
                     }
@@ -912,29 +986,16 @@ impl<'a, const D: usize> Problem<'a, D> {
         }
         let alpha_ref = self.alpha_ref()?;
         let (mut lo, mut hi) = self.log_alpha_range();
-        let y = self.y;
-        let feasible = |fit: &Result<Fit<D>>| {
-            fit.as_ref()
-                .is_ok_and(|f| max_displacement(y, &f.values) <= tolerance)
-        };
         let top = self.fit_log_alpha(alpha_ref, hi, false);
-        if let Ok(f) = &top {
-            trials.push(self.trial(f, None));
-        }
-        if feasible(&top) {
+        if top.as_ref().is_ok_and(|f| record(f, &mut trials)) {
             notes.push("the smoothest spline searched is within the tolerance".into());
             let fit = top?;
             return self.finish(fit, trials, true, notes);
         }
+        // (The guard records a solved trial, feasible or not.)
         let mut best = match self.fit_log_alpha(alpha_ref, lo, false) {
-            Ok(f) if max_displacement(self.y, &f.values) <= tolerance => {
-                trials.push(self.trial(&f, None));
-                f
-            }
-            other => {
-                if let Ok(f) = &other {
-                    trials.push(self.trial(f, None));
-                }
+            Ok(f) if record(&f, &mut trials) => f,
+            _ => {
                 notes.push(
                     "the tolerance is below what any smoothing allows; the result interpolates"
                         .into(),
@@ -948,10 +1009,7 @@ impl<'a, const D: usize> Problem<'a, D> {
         while hi - lo > precision && steps < max_steps {
             let mid = 0.5 * (lo + hi);
             let fit = self.fit_log_alpha(alpha_ref, mid, false);
-            if let Ok(f) = &fit {
-                trials.push(self.trial(f, None));
-            }
-            if feasible(&fit) {
+            if fit.as_ref().is_ok_and(|f| record(f, &mut trials)) {
                 lo = mid;
                 best = fit?;
             } else {

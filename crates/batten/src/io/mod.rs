@@ -75,6 +75,7 @@ mod error;
 mod iges;
 mod json;
 mod limits;
+mod number;
 mod sig;
 mod surface;
 mod svg;
@@ -87,9 +88,9 @@ pub use atomic::{check_writable, remove_temporaries, write_atomic, write_atomic_
 pub use dxf::{DxfCurve, DxfDrawing, DxfGeometry};
 pub use error::{IoError, Location};
 pub use limits::MAX_COORDINATE;
+pub use number::format_f64;
 pub use sig::format_sig;
 pub use surface::{format_surface, parse_surface, read_surface_json, write_surface_json};
-pub use text::format_f64;
 
 use crate::error::Error;
 use crate::geom::{Point, PointSeq, SpaceSeq, Vec2, Xyz};

@@ -241,21 +241,8 @@ impl BSplineCurve {
         }
         let u = self.knots.as_slice();
         let q = p - 1;
-        let mut n = [0.0; MAX_ORDER];
-        let mut left = [0.0; MAX_ORDER];
-        let mut right = [0.0; MAX_ORDER];
-        n[0] = 1.0;
-        for j in 1..=q {
-            left[j] = t - u[k + 1 - j];
-            right[j] = u[k + j] - t;
-            let mut saved = 0.0;
-            for r in 0..j {
-                let temp = n[r] / (right[r + 1] + left[j - r]);
-                n[r] = saved + right[r + 1] * temp;
-                saved = left[j - r] * temp;
-            }
-            n[j] = saved;
-        }
+        // Every denominator of A2.2 spans the non-empty span k, so its 0/0 guard never acts.
+        let n = basis_functions(u, q, k, t);
         let mut d = Vec2::ZERO;
         for (r, nr) in n.iter().enumerate().take(q + 1) {
             let i = k - q + r;
@@ -373,6 +360,14 @@ pub(crate) fn basis_derivs(
         "degree {p} above the supported maximum {}",
         MAX_ORDER - 1
     );
+    if nd == 0 {
+        // The cubic (every report's GFI interpolant) with its loop bounds known.
+        match p {
+            3 => basis_only(u, Cubic, k, t, out),
+            _ => basis_only(u, p, k, t, out),
+        }
+        return;
+    }
     let mut ndu = [[0.0; MAX_ORDER]; MAX_ORDER];
     let mut left = [0.0; MAX_ORDER];
     let mut right = [0.0; MAX_ORDER];
@@ -456,6 +451,65 @@ pub(crate) fn basis_derivs(
     }
 }
 
+/// [`basis_derivs`] without derivatives: [`basis_functions`] into `out[0]`, the other rows
+/// zero. The same operations as the upper triangle of A2.3's table, so the same bits, without
+/// the table and the derivative loops (the B-spline interpolant's collocation matrix, which
+/// the GFI of every report builds).
+fn basis_only(u: &[f64], p: impl Degree, k: usize, t: f64, out: &mut [[f64; MAX_ORDER]; 4]) {
+    out[0] = basis_functions(u, p, k, t);
+    for row in &mut out[1..] {
+        *row = [0.0; MAX_ORDER];
+    }
+}
+
+/// The non-zero basis functions `N_{k−p..=k, p}` at `t` in span `k` (Piegl & Tiller A2.2,
+/// 0/0 := 0 for repeated knots), the rest of the array zero: each level's values overwrite
+/// the level before.
+fn basis_functions(u: &[f64], p: impl Degree, k: usize, t: f64) -> [f64; MAX_ORDER] {
+    let p = p.degree();
+    let mut n = [0.0; MAX_ORDER];
+    let mut left = [0.0; MAX_ORDER];
+    let mut right = [0.0; MAX_ORDER];
+    n[0] = 1.0;
+    for j in 1..=p {
+        left[j] = t - u[k + 1 - j];
+        right[j] = u[k + j] - t;
+        let mut saved = 0.0;
+        for r in 0..j {
+            let den = right[r + 1] + left[j - r];
+            let temp = if den != 0.0 { n[r] / den } else { 0.0 };
+            n[r] = saved + right[r + 1] * temp;
+            saved = left[j - r] * temp;
+        }
+        n[j] = saved;
+    }
+    n
+}
+
+/// A degree known at run time (`usize`) or at compile time ([`Cubic`]), so that one body of
+/// [`basis_only`] serves both.
+trait Degree: Copy {
+    fn degree(self) -> usize;
+}
+
+impl Degree for usize {
+    #[inline(always)]
+    fn degree(self) -> usize {
+        self
+    }
+}
+
+/// Degree 3, known at compile time.
+#[derive(Clone, Copy)]
+struct Cubic;
+
+impl Degree for Cubic {
+    #[inline(always)]
+    fn degree(self) -> usize {
+        3
+    }
+}
+
 impl Curve for BSplineCurve {
     fn domain(&self) -> (f64, f64) {
         let u = self.knots.as_slice();
@@ -502,6 +556,31 @@ impl Piecewise for BSplineCurve {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The basis functions alone ([`basis_only`], nd = 0) are the bits of the full table's
+    /// first row (nd ≥ 1), every degree, span and a spread of parameters, with repeated knots
+    /// (the 0/0 := 0 guard); the derivative rows are zero.
+    #[test]
+    fn basis_only_is_the_tables_first_row() {
+        let u = [
+            0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.13, 0.4, 0.4, 0.4, 0.91, 1.3, 2.2, 2.2, 3.0,
+            3.0, 3.0, 3.0, 3.0, 3.0, 3.0, 3.0,
+        ];
+        for p in 1..MAX_ORDER {
+            for k in p..u.len() - p - 1 {
+                for f in [0.0, 0.1, 0.37, 0.5, 0.999, 1.0] {
+                    let t = u[k] + f * (u[k + 1] - u[k]);
+                    let (mut fast, mut full) = ([[7.0; MAX_ORDER]; 4], [[0.0; MAX_ORDER]; 4]);
+                    basis_derivs(&u, p, k, t, 0, &mut fast);
+                    basis_derivs(&u, p, k, t, 1, &mut full);
+                    for j in 0..MAX_ORDER {
+                        assert_eq!(fast[0][j].to_bits(), full[0][j].to_bits(), "p {p} k {k}");
+                        assert!(fast[1..].iter().all(|r| r[j] == 0.0));
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn cubic_derivs_in_span_match_the_basis_derivatives() {
