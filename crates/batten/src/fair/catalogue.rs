@@ -9,7 +9,7 @@
 
 use serde::Serialize;
 
-use super::{FairMethod, ParamSpec, methods};
+use super::{FairMethod, ParamSpec, ParamType, methods};
 
 /// One parameter of a method.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
@@ -20,27 +20,9 @@ pub struct ParamInfo {
     #[serde(rename = "type")]
     pub kind: ParamType,
     /// The default, as text (`auto` where the method computes it).
-    pub default: &'static str,
+    pub default: String,
     /// One line on what it does.
     pub doc: &'static str,
-}
-
-/// The kind of value a parameter takes, as far as its default text tells.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-#[non_exhaustive]
-pub enum ParamType {
-    /// A real number (`0.5`, `1e-6`, `pi/2`).
-    Number,
-    /// A whole number (`3`).
-    Integer,
-    /// `true` or `false`.
-    Boolean,
-    /// One of several words (`average`, `position-and-tangent`); the doc names them.
-    Choice,
-    /// Anything else, notably `auto` (a value computed from the data unless one is given;
-    /// the doc says what else it takes).
-    Text,
 }
 
 impl ParamType {
@@ -71,10 +53,11 @@ impl ParamType {
 impl ParamInfo {
     /// The entry of one [`ParamSpec`].
     pub fn of(spec: &ParamSpec) -> ParamInfo {
+        let default = spec.default.to_string();
         ParamInfo {
             name: spec.name,
-            kind: ParamType::of_default(spec.default),
-            default: spec.default,
+            kind: ParamType::of_default(&default),
+            default,
             doc: spec.doc,
         }
     }

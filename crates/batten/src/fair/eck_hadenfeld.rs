@@ -586,12 +586,12 @@ pub struct EckHadenfeld;
 static PARAMS: [ParamSpec; 5] = [
     ParamSpec {
         name: "order",
-        default: "2",
+        default: crate::fair::ParamDefault::text(&"2"),
         doc: "derivative order l of the energy ∫|x^(l)|² dt (2 or 3)",
     },
     ParamSpec {
         name: "tabu",
-        default: "4",
+        default: crate::fair::ParamDefault::text(&"4"),
         doc: "length R of the recently-moved list",
     },
     FIT_PARAMS[0],

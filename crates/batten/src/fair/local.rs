@@ -461,17 +461,17 @@ pub(crate) fn resolve_tolerance(tolerance: Option<f64>, curve: &BSplineCurve) ->
 pub(crate) const FIT_PARAMS: [ParamSpec; 3] = [
     ParamSpec {
         name: "degree",
-        default: "3",
+        default: crate::fair::ParamDefault::text(&"3"),
         doc: "degree of the B-spline fitted to point input (2..=5)",
     },
     ParamSpec {
         name: "control_points",
-        default: "auto",
+        default: crate::fair::ParamDefault::text(&"auto"),
         doc: "auto: interpolate the points; N: least-squares fit with N control points",
     },
     ParamSpec {
         name: "free_ends",
-        default: "false",
+        default: crate::fair::ParamDefault::text(&"false"),
         doc: "let the first and last control points move too (ignored with --fix-ends)",
     },
 ];

@@ -93,8 +93,8 @@
 use serde_json::json;
 
 use super::engine::{
-    EPSILON_PARAM, JUMP_ZERO_REL, LocalProblem, MIN_CHORD_REL, MaxTree, THRESHOLD_PARAM, Threshold,
-    drive, driven_parameters, max_fraction, move_limit, tolerance_radius,
+    JUMP_PARAMS, JUMP_ZERO_REL, LocalProblem, MIN_CHORD_REL, MaxTree, Threshold, drive,
+    driven_parameters, max_fraction, move_limit, tolerance_radius,
 };
 pub use super::periodic::MIN_CLOSED_POINTS;
 use super::periodic::{PAD, interpolate_closed, period_index};
@@ -410,7 +410,7 @@ impl FairMethod for SapidisFarin {
     }
 
     fn parameters(&self) -> &'static [ParamSpec] {
-        &[THRESHOLD_PARAM, EPSILON_PARAM]
+        &JUMP_PARAMS
     }
 
     fn supports_closed(&self) -> bool {

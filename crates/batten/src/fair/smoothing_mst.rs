@@ -16,7 +16,7 @@ use crate::spline::{Parametrization, parameters};
 /// The parameter list of [`Mst`].
 static PARAMS: &[ParamSpec] = &[ParamSpec {
     name: "p",
-    default: "auto",
+    default: crate::fair::ParamDefault::text(&"auto"),
     doc: "smoothing parameter in [0, 1] (1 interpolates, 0 is the least-squares line); \
           auto: the smoothest within --tolerance, else generalised cross-validation",
 }];

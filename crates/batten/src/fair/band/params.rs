@@ -24,37 +24,37 @@ pub const DEFAULT_MAX_ITERATIONS: usize = 200;
 pub(super) const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "k",
-        default: "auto",
+        default: crate::fair::ParamDefault::text(&"auto"),
         doc: "automatic tolerance D = k·σ̂ (σ̂ the noise estimate), used when no tolerance is given; auto = max(3, √(2 ln n)), or a number in (0, 100]",
     },
     ParamSpec {
         name: "energy",
-        default: "min-variation",
+        default: crate::fair::ParamDefault::text(&"min-variation"),
         doc: "min-variation (curvature variation off the tangent, re-weighted over the passes) or jerk (|C'''|²)",
     },
     ParamSpec {
         name: "eps",
-        default: "0.02",
+        default: crate::fair::ParamDefault::text(&"0.02"),
         doc: "weight of the full jerk inside the min-variation energy, for regularity; [0, 10]",
     },
     ParamSpec {
         name: "speed",
-        default: "0",
+        default: crate::fair::ParamDefault::text(&"0"),
         doc: "weight of the speed term inside the min-variation energy (the tangential second difference: keeps points from crowding where the curvature peaks); [0, 1e6]",
     },
     ParamSpec {
         name: "fit",
-        default: "1.25",
+        default: crate::fair::ParamDefault::text(&"1.25"),
         doc: "debiasing: the last stage moves back towards the data until the mean residual is fit·σ̂ per coordinate; 0 turns it off; [0, 10]",
     },
     ParamSpec {
         name: "local",
-        default: "2",
+        default: crate::fair::ParamDefault::text(&"2"),
         doc: "debiasing: the data weight is raised where the residual's mean over the smoothing length exceeds local·σ̂/√count (a flattened feature); 0 turns it off; [0, 100]",
     },
     ParamSpec {
         name: "passes",
-        default: "3",
+        default: crate::fair::ParamDefault::text(&"3"),
         doc: "solves, each re-taking parameters and tangents from the previous result; 1..=10",
     },
 ];

@@ -135,17 +135,17 @@ const MIN_LAMBDA_TOL: f64 = 1e-12;
 static PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "tau",
-        default: "0.99",
+        default: crate::fair::ParamDefault::text(&"0.99"),
         doc: "accept a move when GFI_new < tau * GFI, 0 < tau <= 1 (paper: 0.99)",
     },
     ParamSpec {
         name: "lambda_tol",
-        default: "1e-6",
+        default: crate::fair::ParamDefault::text(&"1e-6"),
         doc: "tolerance in lambda of the golden-section search on [0, 1]",
     },
     ParamSpec {
         name: "degree",
-        default: "3",
+        default: crate::fair::ParamDefault::text(&"3"),
         doc: "degree of the interpolating B-spline, 2..=7",
     },
 ];

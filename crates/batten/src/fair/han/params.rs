@@ -42,40 +42,40 @@ pub const DEFAULT_ITERATIONS: usize = 10;
 pub(super) static PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "lambda_coarse",
-        default: "0.8",
+        default: crate::fair::ParamDefault::text(&"0.8"),
         doc: "damping λ_c of coarse case 1 (small vibrations), in [0, 1]",
     },
     ParamSpec {
         name: "lambda_fine",
-        default: "0.75",
+        default: crate::fair::ParamDefault::text(&"0.75"),
         doc: "weight λ_f of the outer points of the fine (inflection) moves, in [0, 1]",
     },
     ParamSpec {
         name: "overlap",
-        default: "5",
+        default: crate::fair::ParamDefault::text(&"5"),
         doc: "points shared by consecutive function segments (k), 1 to 1000000",
     },
     ParamSpec {
         name: "passes",
-        default: "3",
+        default: crate::fair::ParamDefault::text(&"3"),
         doc: "pipeline passes (partition, fair, blend)",
     },
     ParamSpec {
         name: "max_turn",
-        default: "pi/2",
+        default: crate::fair::ParamDefault::text(&"pi/2"),
         doc: "turning range of a segment in radians, in (0, π]; accepts pi and pi/N; the \
               paper's value is pi; pi/2 (the spec's recommendation) keeps segments away from \
               vertical slopes",
     },
     ParamSpec {
         name: "fine_run3",
-        default: "true",
+        default: crate::fair::ParamDefault::text(&"true"),
         doc: "extension, not in the paper: also remove runs of three points of one sign of c \
               (fine case 3); false gives the paper's method",
     },
     ParamSpec {
         name: "alpha_factor",
-        default: "0.2",
+        default: crate::fair::ParamDefault::text(&"0.2"),
         doc: "fine phase target α = factor × the smaller-magnitude neighbour of c, in [0, 1]",
     },
 ];

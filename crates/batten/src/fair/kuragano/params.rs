@@ -13,32 +13,32 @@ use crate::fair::{FairOptions, ParamSpec};
 pub(super) const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "degree",
-        default: "auto",
+        default: crate::fair::ParamDefault::text(&"auto"),
         doc: "degree 1..6 of the ρ(s) polynomial; auto: the best degree of the evaluation",
     },
     ParamSpec {
         name: "samples",
-        default: "auto",
+        default: crate::fair::ParamDefault::text(&"auto"),
         doc: "number N_s of ρ samples along the normalised arc length, 7..=100000; auto: max(41, 10 per segment + 1)",
     },
     ParamSpec {
         name: "rho_max",
-        default: "auto",
+        default: crate::fair::ParamDefault::text(&"auto"),
         doc: "cap on |ρ| in data units (straight parts); auto: 100 × the curve length",
     },
     ParamSpec {
         name: "residual",
-        default: "rho",
+        default: crate::fair::ParamDefault::text(&"rho"),
         doc: "rho: ρ − ρ̂ (curvature form where ρ is infinite); kappa: κ − 1/ρ̂",
     },
     ParamSpec {
         name: "ends",
-        default: "gradients",
+        default: crate::fair::ParamDefault::text(&"gradients"),
         doc: "ends of the quintic interpolant: gradients (estimated at points 0, 1, m−2, m−1) or natural (R'' = R'''' = 0)",
     },
     ParamSpec {
         name: "gradient_fraction",
-        default: "1",
+        default: crate::fair::ParamDefault::text(&"1"),
         doc: "end-gradient magnitude as a fraction of the end chord (the paper's default is 1/3)",
     },
 ];

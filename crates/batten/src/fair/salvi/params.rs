@@ -162,42 +162,42 @@ impl Default for SalviParams {
 pub(super) static PARAMS: [ParamSpec; 11] = [
     ParamSpec {
         name: "samples",
-        default: "auto",
+        default: crate::fair::ParamDefault::text(&"auto"),
         doc: "number of curvature samples N, 4..=20000 (auto: max(200, 8 per knot span))",
     },
     ParamSpec {
         name: "smoother",
-        default: "average",
+        default: crate::fair::ParamDefault::text(&"average"),
         doc: "target curvature: average (moving average) or bspline (least-squares fit of κ(s))",
     },
     ParamSpec {
         name: "half_width",
-        default: "auto",
+        default: crate::fair::ParamDefault::text(&"auto"),
         doc: "moving-average half-width in samples (auto: N/20; at most 20000)",
     },
     ParamSpec {
         name: "passes",
-        default: "3",
+        default: crate::fair::ParamDefault::text(&"3"),
         doc: "moving-average passes",
     },
     ParamSpec {
         name: "target_coefficients",
-        default: "auto",
+        default: crate::fair::ParamDefault::text(&"auto"),
         doc: "coefficients of the bspline target fit (auto: max(4, N/20); at most 20000)",
     },
     ParamSpec {
         name: "pin_ends",
-        default: "false",
+        default: crate::fair::ParamDefault::text(&"false"),
         doc: "make the target equal the curvature at both ends",
     },
     ParamSpec {
         name: "tabu",
-        default: "4",
+        default: crate::fair::ParamDefault::text(&"4"),
         doc: "length R of the recently-moved list",
     },
     ParamSpec {
         name: "window",
-        default: "50",
+        default: crate::fair::ParamDefault::text(&"50"),
         doc: "stop when the measure improved < 0.1% over this many iterations (0: never; at most 1000000)",
     },
     FIT_PARAMS[0],
