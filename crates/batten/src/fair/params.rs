@@ -10,6 +10,7 @@
 //! outside the declared range, is an [`Error::InvalidParameter`] naming the parameter in one
 //! line.
 
+use std::f64::consts::PI;
 use std::fmt;
 
 use serde::Serialize;
@@ -271,6 +272,63 @@ impl<T: Scalar> Kind for Auto<T> {
     }
 }
 
+/// An angle in radians in (0, π]: a number, `pi` (or `π`), or `pi/N`. The default shows as
+/// `pi` or `pi/N` when it is one of those.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Angle {
+    pub(crate) default: f64,
+}
+
+impl Declared for Angle {
+    fn default_text(&self) -> String {
+        let n = PI / self.default;
+        if self.default == PI {
+            "pi".to_string()
+        } else if n.fract() == 0.0 && n > 1.0 && PI / n == self.default {
+            format!("pi/{n}")
+        } else {
+            crate::io::format_f64(self.default)
+        }
+    }
+
+    fn param_type(&self) -> ParamType {
+        ParamType::Number
+    }
+}
+
+impl Kind for Angle {
+    type Value = f64;
+
+    fn read(&self, name: &str, text: Option<&str>) -> Result<f64> {
+        let Some(text) = text else {
+            return Ok(self.default);
+        };
+        let t = text.trim().to_ascii_lowercase().replace('π', "pi");
+        let bad = || {
+            invalid(
+                name,
+                format!("'{text}' is not an angle (radians, pi or pi/N)"),
+            )
+        };
+        let v = if t == "pi" {
+            PI
+        } else if let Some(d) = t.strip_prefix("pi/") {
+            PI / d.trim().parse::<f64>().map_err(|_| bad())?
+        } else {
+            t.parse::<f64>().map_err(|_| bad())?
+        };
+        if v > 0.0 && v <= PI {
+            Ok(v)
+        } else {
+            Err(invalid(name, format!("{v} is outside (0, π]")))
+        }
+    }
+
+    fn json(value: f64) -> Value {
+        value.into()
+    }
+}
+
 /// A boolean: `true/false`, `yes/no`, `1/0`, `on/off`, any case.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Flag {
@@ -460,6 +518,25 @@ mod tests {
             reason(c.read("x", Some("k"))),
             "'k' is not one of rho, kappa"
         );
+    }
+
+    #[test]
+    fn angle_forms() {
+        let a = Angle {
+            default: std::f64::consts::FRAC_PI_2,
+        };
+        assert_eq!(a.read("t", Some("pi")).ok(), Some(PI));
+        assert_eq!(
+            a.read("t", Some("π/2")).ok(),
+            Some(std::f64::consts::FRAC_PI_2)
+        );
+        assert_eq!(a.read("t", Some(" 1.25 ")).ok(), Some(1.25));
+        assert_eq!(reason(a.read("t", Some("4"))), "4 is outside (0, π]");
+        assert!(a.read("t", Some("pi/x")).is_err());
+        assert!(a.read("t", Some("0")).is_err());
+        assert_eq!(a.default_text(), "pi/2");
+        assert_eq!(Angle { default: PI }.default_text(), "pi");
+        assert_eq!(Angle { default: 1.25 }.default_text(), "1.25");
     }
 
     #[test]
