@@ -239,6 +239,17 @@ pub(crate) struct Auto<T> {
     pub(crate) max: T,
 }
 
+impl<T: Scalar> Param<Auto<T>> {
+    /// The same parameter with the range `[min, max]`, for bounds known only at run time (a
+    /// count of control points between the degree and the number of points).
+    pub(crate) fn within(self, min: T, max: T) -> Param<Auto<T>> {
+        Param {
+            kind: Auto { min, max },
+            ..self
+        }
+    }
+}
+
 impl<T: Scalar> Declared for Auto<T> {
     fn default_text(&self) -> String {
         "auto".to_string()
