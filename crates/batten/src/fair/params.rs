@@ -73,11 +73,6 @@ pub struct ParamSpec {
 pub struct ParamDefault(&'static dyn Declared);
 
 impl ParamDefault {
-    /// A default given as text only, for a table not yet made of [`Param`] declarations.
-    pub(crate) const fn text(text: &'static &'static str) -> ParamDefault {
-        ParamDefault(text)
-    }
-
     /// The kind of value the parameter takes.
     pub fn param_type(&self) -> ParamType {
         self.0.param_type()
@@ -114,16 +109,6 @@ pub(crate) trait Declared: fmt::Debug + Sync {
     fn default_text(&self) -> String;
     /// The kind of value, for the catalogue.
     fn param_type(&self) -> ParamType;
-}
-
-impl Declared for &'static str {
-    fn default_text(&self) -> String {
-        self.to_string()
-    }
-
-    fn param_type(&self) -> ParamType {
-        ParamType::of_default(self)
-    }
 }
 
 /// A kind of parameter: how its text is read and how a value is written into a report.

@@ -13,13 +13,18 @@ use crate::error::Result;
 use crate::geom::{Point, PointSeq, SpaceSeq, Xyz};
 use crate::spline::{Parametrization, parameters};
 
-/// The parameter list of [`Mst`].
-static PARAMS: &[ParamSpec] = &[ParamSpec {
+use super::params::{Auto, Param};
+
+/// The smoothing parameter p (`auto`: chosen for the tolerance, or by GCV).
+pub(crate) const P: Param<Auto<f64>> = Param {
     name: "p",
-    default: crate::fair::ParamDefault::text(&"auto"),
+    kind: Auto { min: 0.0, max: 1.0 },
     doc: "smoothing parameter in [0, 1] (1 interpolates, 0 is the least-squares line); \
           auto: the smoothest within --tolerance, else generalised cross-validation",
-}];
+};
+
+/// The parameter list of [`Mst`].
+static PARAMS: &[ParamSpec] = &[P.spec()];
 
 /// The `mst` fairing method: the cubic smoothing spline of the points at chord-length
 /// parameters, with p given (`--set p=…`), chosen for `--tolerance`, or by GCV. See the module
