@@ -7,8 +7,9 @@
 //! every report has in common: displacements, metrics before and after, whether the tolerance
 //! held, elapsed time.
 //!
-//! Adding a method: implement [`FairMethod`] in a file of its own under `fair/` and list it
-//! in [`methods`].
+//! Adding a method: implement [`FairMethod`] in a file of its own under `fair/`, declare each
+//! of its parameters once as a `Param` constant (`params.rs`: key, kind with default and
+//! range, doc) and list it in [`methods`].
 
 pub mod band;
 pub mod cali;

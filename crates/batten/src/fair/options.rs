@@ -4,7 +4,7 @@ use std::str::FromStr;
 
 use serde::Serialize;
 
-use super::params::{Auto, Choice, Flag, Kind, Number, Param, Scalar};
+use super::params::{Kind, Param};
 use crate::error::{Error, Result};
 
 /// What `--fix-ends` keeps at the two ends of an open curve: nothing, the end points
@@ -127,7 +127,7 @@ pub struct FairOptions {
     /// Default value: `None`.
     pub max_iterations: Option<usize>,
     /// Method parameters as `key = value` text (from `--set key=value`), checked against the
-    /// method's [`ParamSpec`]s.
+    /// method's [`ParamSpec`](super::ParamSpec)s.
     ///
     /// Default value: empty.
     pub params: BTreeMap<String, String>,
@@ -237,88 +237,6 @@ impl FairOptions {
     /// [`Error::InvalidParameter`] naming the parameter.
     pub(crate) fn get<K: Kind + 'static>(&self, param: &Param<K>) -> Result<K::Value> {
         param.read(self.params.get(param.name).map(String::as_str))
-    }
-
-    /// The text given for `key`, if any.
-    fn text(&self, key: &str) -> Option<&str> {
-        self.params.get(key).map(String::as_str)
-    }
-
-    /// A numeric parameter, or `None` when it was not set.
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] when the text is not a finite number.
-    pub fn param_f64(&self, key: &str) -> Result<Option<f64>> {
-        self.text(key).map(|s| f64::parse(key, s)).transpose()
-    }
-
-    /// A numeric parameter with a default, checked to lie in `[lo, hi]`.
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] when it is not a number or out of range.
-    pub fn param_f64_in(&self, key: &str, default: f64, lo: f64, hi: f64) -> Result<f64> {
-        let kind = Number {
-            default,
-            min: lo,
-            max: hi,
-        };
-        kind.read(key, self.text(key))
-    }
-
-    /// A non-negative integer parameter with a default, checked to lie in `[lo, hi]`.
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] when it is not a whole number or out of range.
-    pub fn param_usize_in(&self, key: &str, default: usize, lo: usize, hi: usize) -> Result<usize> {
-        let kind = Number {
-            default,
-            min: lo,
-            max: hi,
-        };
-        kind.read(key, self.text(key))
-    }
-
-    /// Whether the parameter `key` is left to the method: not given, or `auto`.
-    pub fn param_is_auto(&self, key: &str) -> bool {
-        matches!(self.params.get(key).map(|s| s.trim()), None | Some("auto"))
-    }
-
-    /// A number in `[lo, hi]`, or `None` when the parameter is not given or `auto`.
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] for a value that is not a number or out of range.
-    pub fn param_auto_f64_in(&self, key: &str, lo: f64, hi: f64) -> Result<Option<f64>> {
-        Auto { min: lo, max: hi }.read(key, self.text(key))
-    }
-
-    /// A count in `[lo, hi]`, or `None` when the parameter is not given or `auto`.
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] for a value that is not a count or out of range.
-    pub fn param_auto_usize_in(&self, key: &str, lo: usize, hi: usize) -> Result<Option<usize>> {
-        Auto { min: lo, max: hi }.read(key, self.text(key))
-    }
-
-    /// A boolean method parameter, with a default: `true/false`, `yes/no`, `1/0`, `on/off`
-    /// (any case), the same for every method.
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] for anything else.
-    pub fn param_bool(&self, key: &str, default: bool) -> Result<bool> {
-        Flag { default }.read(key, self.text(key))
-    }
-
-    /// A parameter that must be one of `choices`, with a default.
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] naming the allowed values.
-    pub fn param_choice(
-        &self,
-        key: &str,
-        default: &'static str,
-        choices: &'static [&'static str],
-    ) -> Result<&'static str> {
-        Choice { default, choices }.read(key, self.text(key))
     }
 }
 
