@@ -2,10 +2,14 @@
 //! parameters, for `batten methods --json` and the Python package's `batten.methods()`.
 //!
 //! Built from the registry's own [`FairMethod`] answers, so it cannot drift from what the
-//! methods accept. A parameter's [`ParamType`] is read from its default text (the
-//! [`ParamSpec`] holds text only): `true`/`false` are booleans, whole numbers integers,
-//! other numbers (and `pi`, `pi/N`) numbers, a lowercase word one of several choices, and
-//! anything else (`auto`: computed from the data unless given) text.
+//! methods accept: each entry is a parameter's declaration ([`ParamSpec`]) with its default
+//! shown as text. The listed [`ParamType`] is still read from that text, as it was before the
+//! declarations were typed ([`ParamType::of_default`]): `true`/`false` are booleans, whole
+//! numbers integers, other numbers (and `pi`, `pi/N`) numbers, a lowercase word one of
+//! several choices, and anything else (`auto`: computed from the data unless given) text. It
+//! differs from the declared kind ([`ParamDefault::param_type`](super::ParamDefault)) only
+//! for real-valued parameters whose default is a whole number (`band`'s `speed` and `local`,
+//! `kuragano`'s `gradient_fraction`), which are listed as integers.
 
 use serde::Serialize;
 
@@ -99,6 +103,26 @@ pub fn catalogue() -> Vec<MethodInfo> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The listed type is the declared one, but for real parameters with a whole-number
+    /// default (listed as integers).
+    #[test]
+    fn listed_types_are_the_declared_ones_but_for_whole_number_defaults() {
+        let mut integers = Vec::new();
+        for m in methods() {
+            for p in m.parameters() {
+                let (listed, declared) = (ParamInfo::of(p).kind, p.default.param_type());
+                if listed != declared {
+                    assert_eq!((listed, declared), (ParamType::Integer, ParamType::Number));
+                    integers.push(format!("{}.{}", m.name(), p.name));
+                }
+            }
+        }
+        assert_eq!(
+            integers,
+            ["band.speed", "band.local", "kuragano.gradient_fraction"]
+        );
+    }
 
     #[test]
     fn types_follow_the_default_text() {
