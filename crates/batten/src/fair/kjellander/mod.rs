@@ -114,7 +114,7 @@ use super::{FairMethod, FairOptions, Outcome, ParamSpec};
 use crate::error::Result;
 use crate::geom::PointSeq;
 
-use super::engine::JUMP_PARAMS;
+use super::engine::{EPSILON, JUMP_PARAMS};
 // The engine's constants, at the paths they had when the engine lived here.
 pub use super::engine::{
     DEFAULT_MOVES_PER_POINT, DEFAULT_THRESHOLD, JUMP_ZERO_REL, MIN_CHORD_REL, MIN_STEP_FRACTION,
@@ -146,11 +146,11 @@ pub struct Energy;
 
 /// Parameters in data units of `kjellander` and their power of length: the jumps of the
 /// uniform spline's third derivative are lengths.
-const UNIFORM_LENGTH_PARAMS: &[(&str, i32)] = &[("epsilon", 1), ("initial_max_jump", 1)];
+const UNIFORM_LENGTH_PARAMS: &[(&str, i32)] = &[(EPSILON.name, 1), ("initial_max_jump", 1)];
 
 /// Parameters in data units of `poliakoff` and `energy`: on the chord-length spline the
 /// third derivative has the unit 1/length².
-const CHORD_LENGTH_PARAMS: &[(&str, i32)] = &[("epsilon", -2), ("initial_max_jump", -2)];
+const CHORD_LENGTH_PARAMS: &[(&str, i32)] = &[(EPSILON.name, -2), ("initial_max_jump", -2)];
 
 impl FairMethod for Kjellander {
     fn name(&self) -> &'static str {

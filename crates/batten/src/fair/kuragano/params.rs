@@ -106,4 +106,4 @@ impl Kuragano {
 }
 
 /// Parameters in data units and their power of length.
-pub(super) const LENGTH_PARAMS: &[(&str, i32)] = &[("rho_max", 1), ("arc_length", 1)];
+pub(super) const LENGTH_PARAMS: &[(&str, i32)] = &[(RHO_MAX.name, 1), ("arc_length", 1)];

@@ -5,11 +5,11 @@
 use serde_json::{Map, Value, json};
 
 use super::Kuragano;
-use super::params::{DEGREE, ENDS, GRADIENT_FRACTION, RHO_MAX, SAMPLES};
+use super::params::{DEGREE, ENDS, GRADIENT_FRACTION, RESIDUAL, RHO_MAX, SAMPLES};
 use crate::analysis::roc_fairness::{
-    Design, DesignEnds, Evaluation, KuraganoOptions, MIN_DEGREE, Modification, RhoFit, RhoSamples,
-    ShapeConstraints, StopReason, design_curve, design_samples, evaluate_detailed, fits,
-    modify_shape,
+    Design, DesignEnds, Evaluation, KuraganoOptions, MIN_DEGREE, Modification, Residual, RhoFit,
+    RhoSamples, ShapeConstraints, StopReason, design_curve, design_samples, evaluate_detailed,
+    fits, modify_shape,
 };
 use crate::curve::Curve;
 use crate::error::{Error, Result};
@@ -103,7 +103,11 @@ fn design_parameters(
 ) {
     SAMPLES.write(parameters, Some(samples.s.len()));
     RHO_MAX.write(parameters, Some(samples.rho_max));
-    parameters.insert("residual".into(), json!(kopts.residual));
+    let residual = match kopts.residual {
+        Residual::Rho => "rho",
+        Residual::Kappa => "kappa",
+    };
+    RESIDUAL.write(parameters, residual);
     let ends = match kopts.ends {
         DesignEnds::Natural => "natural",
         DesignEnds::Gradients { .. } => "gradients",
