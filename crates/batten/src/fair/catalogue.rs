@@ -2,14 +2,9 @@
 //! parameters, for `batten methods --json` and the Python package's `batten.methods()`.
 //!
 //! Built from the registry's own [`FairMethod`] answers, so it cannot drift from what the
-//! methods accept: each entry is a parameter's declaration ([`ParamSpec`]) with its default
-//! shown as text. The listed [`ParamType`] is still read from that text, as it was before the
-//! declarations were typed ([`ParamType::of_default`]): `true`/`false` are booleans, whole
-//! numbers integers, other numbers (and `pi`, `pi/N`) numbers, a lowercase word one of
-//! several choices, and anything else (`auto`: computed from the data unless given) text. It
-//! differs from the declared kind ([`ParamDefault::param_type`](super::ParamDefault)) only
-//! for real-valued parameters whose default is a whole number (`band`'s `speed` and `local`,
-//! `kuragano`'s `gradient_fraction`), which are listed as integers.
+//! methods accept: each entry is a parameter's declaration ([`ParamSpec`]), its type the
+//! declared kind ([`ParamDefault::param_type`](super::ParamDefault::param_type)) and its
+//! default shown as text.
 
 use serde::Serialize;
 
@@ -20,7 +15,7 @@ use super::{FairMethod, ParamSpec, ParamType, methods};
 pub struct ParamInfo {
     /// The key of `--set KEY=VALUE` (a keyword argument in Python).
     pub name: &'static str,
-    /// What kind of value it takes, as read from the default.
+    /// What kind of value it takes, as declared.
     #[serde(rename = "type")]
     pub kind: ParamType,
     /// The default, as text (`auto` where the method computes it).
@@ -29,39 +24,13 @@ pub struct ParamInfo {
     pub doc: &'static str,
 }
 
-impl ParamType {
-    /// The kind of value whose default text is `default`.
-    pub fn of_default(default: &str) -> ParamType {
-        let d = default.trim();
-        let is_pi = d == "pi"
-            || d.strip_prefix("pi/")
-                .is_some_and(|n| n.parse::<f64>().is_ok_and(f64::is_finite));
-        if d == "true" || d == "false" {
-            ParamType::Boolean
-        } else if d.parse::<i64>().is_ok() {
-            ParamType::Integer
-        } else if d.parse::<f64>().is_ok_and(f64::is_finite) || is_pi {
-            ParamType::Number
-        } else if d != "auto"
-            && !d.is_empty()
-            && d.chars()
-                .all(|c| c.is_ascii_lowercase() || c == '-' || c == '_')
-        {
-            ParamType::Choice
-        } else {
-            ParamType::Text
-        }
-    }
-}
-
 impl ParamInfo {
     /// The entry of one [`ParamSpec`].
     pub fn of(spec: &ParamSpec) -> ParamInfo {
-        let default = spec.default.to_string();
         ParamInfo {
             name: spec.name,
-            kind: ParamType::of_default(&default),
-            default,
+            kind: spec.default.param_type(),
+            default: spec.default.to_string(),
             doc: spec.doc,
         }
     }
@@ -104,46 +73,39 @@ pub fn catalogue() -> Vec<MethodInfo> {
 mod tests {
     use super::*;
 
-    /// The listed type is the declared one, but for real parameters with a whole-number
-    /// default (listed as integers).
+    /// Real-valued parameters are numbers whatever their default (`band`'s `speed=0` takes
+    /// `0.5`), counts integers, `auto`-or-a-value parameters text.
     #[test]
-    fn listed_types_are_the_declared_ones_but_for_whole_number_defaults() {
-        let mut integers = Vec::new();
-        for m in methods() {
-            for p in m.parameters() {
-                let (listed, declared) = (ParamInfo::of(p).kind, p.default.param_type());
-                if listed != declared {
-                    assert_eq!((listed, declared), (ParamType::Integer, ParamType::Number));
-                    integers.push(format!("{}.{}", m.name(), p.name));
-                }
-            }
-        }
+    fn types_are_the_declared_kinds() {
+        let kind = |method: &str, param: &str| {
+            catalogue()
+                .into_iter()
+                .find(|m| m.name == method)
+                .and_then(|m| m.parameters.into_iter().find(|p| p.name == param))
+                .map(|p| (p.kind, p.default))
+        };
+        let number = |d: &str| Some((ParamType::Number, d.to_string()));
+        assert_eq!(kind("band", "speed"), number("0"));
+        assert_eq!(kind("band", "local"), number("2"));
+        assert_eq!(kind("kuragano", "gradient_fraction"), number("1"));
+        assert_eq!(kind("han", "max_turn"), number("pi/2"));
+        assert_eq!(kind("cali", "lambda_tol"), number("1e-6"));
         assert_eq!(
-            integers,
-            ["band.speed", "band.local", "kuragano.gradient_fraction"]
+            kind("band", "passes"),
+            Some((ParamType::Integer, "3".to_string()))
         );
-    }
-
-    #[test]
-    fn types_follow_the_default_text() {
-        let cases = [
-            ("true", ParamType::Boolean),
-            ("false", ParamType::Boolean),
-            ("3", ParamType::Integer),
-            ("0", ParamType::Integer),
-            ("0.99", ParamType::Number),
-            ("1e-6", ParamType::Number),
-            ("pi", ParamType::Number),
-            ("pi/2", ParamType::Number),
-            ("average", ParamType::Choice),
-            ("position-and-tangent", ParamType::Choice),
-            ("auto", ParamType::Text),
-            ("NaN", ParamType::Text),
-            ("", ParamType::Text),
-        ];
-        for (text, kind) in cases {
-            assert_eq!(ParamType::of_default(text), kind, "{text:?}");
-        }
+        assert_eq!(
+            kind("han", "fine_run3"),
+            Some((ParamType::Boolean, "true".to_string()))
+        );
+        assert_eq!(
+            kind("band", "energy"),
+            Some((ParamType::Choice, "min-variation".to_string()))
+        );
+        assert_eq!(
+            kind("salvi", "control_points"),
+            Some((ParamType::Text, "auto".to_string()))
+        );
     }
 
     #[test]
