@@ -61,13 +61,12 @@ fn listing(methods: &[&dyn FairMethod], default: &str) -> String {
             continue;
         }
         s.push_str("  parameters (--set KEY=VALUE):\n");
-        let width = params
+        let pairs: Vec<String> = params
             .iter()
-            .map(|p| p.name.len() + p.default.len() + 1)
-            .max()
-            .unwrap_or(0);
-        for p in params {
-            let kv = format!("{}={}", p.name, p.default);
+            .map(|p| format!("{}={}", p.name, p.default))
+            .collect();
+        let width = pairs.iter().map(String::len).max().unwrap_or(0);
+        for (kv, p) in pairs.iter().zip(params) {
             let _ = writeln!(s, "    {kv:<width$}  {}", p.doc);
         }
     }

@@ -2,70 +2,26 @@
 //! parameters, for `batten methods --json` and the Python package's `batten.methods()`.
 //!
 //! Built from the registry's own [`FairMethod`] answers, so it cannot drift from what the
-//! methods accept. A parameter's [`ParamType`] is read from its default text (the
-//! [`ParamSpec`] holds text only): `true`/`false` are booleans, whole numbers integers,
-//! other numbers (and `pi`, `pi/N`) numbers, a lowercase word one of several choices, and
-//! anything else (`auto`: computed from the data unless given) text.
+//! methods accept: each entry is a parameter's declaration ([`ParamSpec`]), its type the
+//! declared kind ([`ParamDefault::param_type`](super::ParamDefault::param_type)) and its
+//! default shown as text.
 
 use serde::Serialize;
 
-use super::{FairMethod, ParamSpec, methods};
+use super::{FairMethod, ParamSpec, ParamType, methods};
 
 /// One parameter of a method.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct ParamInfo {
     /// The key of `--set KEY=VALUE` (a keyword argument in Python).
     pub name: &'static str,
-    /// What kind of value it takes, as read from the default.
+    /// What kind of value it takes, as declared.
     #[serde(rename = "type")]
     pub kind: ParamType,
     /// The default, as text (`auto` where the method computes it).
-    pub default: &'static str,
+    pub default: String,
     /// One line on what it does.
     pub doc: &'static str,
-}
-
-/// The kind of value a parameter takes, as far as its default text tells.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-#[non_exhaustive]
-pub enum ParamType {
-    /// A real number (`0.5`, `1e-6`, `pi/2`).
-    Number,
-    /// A whole number (`3`).
-    Integer,
-    /// `true` or `false`.
-    Boolean,
-    /// One of several words (`average`, `position-and-tangent`); the doc names them.
-    Choice,
-    /// Anything else, notably `auto` (a value computed from the data unless one is given;
-    /// the doc says what else it takes).
-    Text,
-}
-
-impl ParamType {
-    /// The kind of value whose default text is `default`.
-    pub fn of_default(default: &str) -> ParamType {
-        let d = default.trim();
-        let is_pi = d == "pi"
-            || d.strip_prefix("pi/")
-                .is_some_and(|n| n.parse::<f64>().is_ok_and(f64::is_finite));
-        if d == "true" || d == "false" {
-            ParamType::Boolean
-        } else if d.parse::<i64>().is_ok() {
-            ParamType::Integer
-        } else if d.parse::<f64>().is_ok_and(f64::is_finite) || is_pi {
-            ParamType::Number
-        } else if d != "auto"
-            && !d.is_empty()
-            && d.chars()
-                .all(|c| c.is_ascii_lowercase() || c == '-' || c == '_')
-        {
-            ParamType::Choice
-        } else {
-            ParamType::Text
-        }
-    }
 }
 
 impl ParamInfo {
@@ -73,8 +29,8 @@ impl ParamInfo {
     pub fn of(spec: &ParamSpec) -> ParamInfo {
         ParamInfo {
             name: spec.name,
-            kind: ParamType::of_default(spec.default),
-            default: spec.default,
+            kind: spec.default.param_type(),
+            default: spec.default.to_string(),
             doc: spec.doc,
         }
     }
@@ -117,26 +73,39 @@ pub fn catalogue() -> Vec<MethodInfo> {
 mod tests {
     use super::*;
 
+    /// Real-valued parameters are numbers whatever their default (`band`'s `speed=0` takes
+    /// `0.5`), counts integers, `auto`-or-a-value parameters text.
     #[test]
-    fn types_follow_the_default_text() {
-        let cases = [
-            ("true", ParamType::Boolean),
-            ("false", ParamType::Boolean),
-            ("3", ParamType::Integer),
-            ("0", ParamType::Integer),
-            ("0.99", ParamType::Number),
-            ("1e-6", ParamType::Number),
-            ("pi", ParamType::Number),
-            ("pi/2", ParamType::Number),
-            ("average", ParamType::Choice),
-            ("position-and-tangent", ParamType::Choice),
-            ("auto", ParamType::Text),
-            ("NaN", ParamType::Text),
-            ("", ParamType::Text),
-        ];
-        for (text, kind) in cases {
-            assert_eq!(ParamType::of_default(text), kind, "{text:?}");
-        }
+    fn types_are_the_declared_kinds() {
+        let kind = |method: &str, param: &str| {
+            catalogue()
+                .into_iter()
+                .find(|m| m.name == method)
+                .and_then(|m| m.parameters.into_iter().find(|p| p.name == param))
+                .map(|p| (p.kind, p.default))
+        };
+        let number = |d: &str| Some((ParamType::Number, d.to_string()));
+        assert_eq!(kind("band", "speed"), number("0"));
+        assert_eq!(kind("band", "local"), number("2"));
+        assert_eq!(kind("kuragano", "gradient_fraction"), number("1"));
+        assert_eq!(kind("han", "max_turn"), number("pi/2"));
+        assert_eq!(kind("cali", "lambda_tol"), number("1e-6"));
+        assert_eq!(
+            kind("band", "passes"),
+            Some((ParamType::Integer, "3".to_string()))
+        );
+        assert_eq!(
+            kind("han", "fine_run3"),
+            Some((ParamType::Boolean, "true".to_string()))
+        );
+        assert_eq!(
+            kind("band", "energy"),
+            Some((ParamType::Choice, "min-variation".to_string()))
+        );
+        assert_eq!(
+            kind("salvi", "control_points"),
+            Some((ParamType::Text, "auto".to_string()))
+        );
     }
 
     #[test]

@@ -48,9 +48,10 @@ use serde_json::Value;
 
 use super::clean::ControlCheck;
 use super::local::{
-    self, DEFAULT_TABU_LENGTH, FIT_PARAMS, LocalReport, RecentList, RunningMax, clamp_point,
-    movable_mask, resolve_tolerance, select_candidate,
+    self, CONTROL_POINTS, DEFAULT_TABU_LENGTH, FIT_DEGREE, FREE_ENDS, LocalReport, RecentList,
+    RunningMax, TABU, clamp_point, movable_mask, resolve_tolerance, select_candidate,
 };
+use super::params::{Number, Param};
 use super::periodic::{PAD, interpolate_closed, period_index};
 use super::{FairMethod, FairOptions, HistoryRow, Move, Outcome, ParamSpec};
 use crate::curve::Curve;
@@ -583,20 +584,23 @@ fn fair_control_points(
 #[derive(Clone, Copy, Debug, Default)]
 pub struct EckHadenfeld;
 
+/// The derivative order l of the energy ([`DEFAULT_ORDER`]).
+const ORDER: Param<Number<usize>> = Param {
+    name: "order",
+    kind: Number {
+        default: DEFAULT_ORDER,
+        min: 2,
+        max: 3,
+    },
+    doc: "derivative order l of the energy ∫|x^(l)|² dt (2 or 3)",
+};
+
 static PARAMS: [ParamSpec; 5] = [
-    ParamSpec {
-        name: "order",
-        default: "2",
-        doc: "derivative order l of the energy ∫|x^(l)|² dt (2 or 3)",
-    },
-    ParamSpec {
-        name: "tabu",
-        default: "4",
-        doc: "length R of the recently-moved list",
-    },
-    FIT_PARAMS[0],
-    FIT_PARAMS[1],
-    FIT_PARAMS[2],
+    ORDER.spec(),
+    TABU.spec(),
+    FIT_DEGREE.spec(),
+    CONTROL_POINTS.spec(),
+    FREE_ENDS.spec(),
 ];
 
 impl FairMethod for EckHadenfeld {
@@ -645,10 +649,7 @@ impl FairMethod for EckHadenfeld {
 
 /// The `order` and `tabu` parameters, checked.
 fn order_and_tabu(options: &FairOptions) -> Result<(usize, usize)> {
-    Ok((
-        options.param_usize_in("order", DEFAULT_ORDER, 2, 3)?,
-        options.param_usize_in("tabu", DEFAULT_TABU_LENGTH, 0, 1000)?,
-    ))
+    Ok((options.get(&ORDER)?, options.get(&TABU)?))
 }
 
 /// The method on a fitted (or given) B-spline; `input` holds the points the output is
@@ -690,8 +691,8 @@ fn outcome(
     notes: Vec<String>,
     curve: Option<BSplineCurve>,
 ) -> Outcome {
-    parameters.insert("order".into(), Value::from(params.order));
-    parameters.insert("tabu".into(), params.tabu_length.into());
+    ORDER.write(&mut parameters, params.order);
+    TABU.write(&mut parameters, params.tabu_length);
     parameters.insert("max_iterations".into(), params.max_iterations.into());
     local::insert_common(&mut parameters, &report);
     report.into_outcome(points, parameters, notes, curve, params.free_ends)
@@ -710,7 +711,7 @@ fn run_closed(input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
             reason: format!("a closed curve is faired as the periodic cubic, not degree {degree}"),
         });
     }
-    if !options.param_is_auto("control_points") {
+    if options.get(&CONTROL_POINTS)?.is_some() {
         return Err(Error::InvalidParameter {
             name: "control_points".into(),
             reason: "a closed curve is interpolated (one control point per point)".into(),
@@ -777,8 +778,8 @@ fn run_closed(input: &PointSeq, options: &FairOptions) -> Result<Outcome> {
     let out: Vec<Point> = t.iter().map(|&tk| faired.eval(tk)).collect();
     let mut parameters = serde_json::Map::new();
     parameters.insert("fit".into(), "periodic cubic interpolation".into());
-    parameters.insert("degree".into(), 3.into());
-    parameters.insert("control_points".into(), n.into());
+    FIT_DEGREE.write(&mut parameters, 3);
+    CONTROL_POINTS.write(&mut parameters, Some(n));
     parameters.insert("fit_residual".into(), local::json_f64(residual));
     parameters.insert("delta".into(), local::json_f64(delta));
     // The wrapped form is not a clamped curve of its own: no curve is returned.

@@ -23,7 +23,8 @@ use std::ops::Range;
 
 use serde::Serialize;
 
-use super::{FairOptions, FairStatus, HistoryRow, Move, Outcome, ParamSpec};
+use super::params::{Auto, Flag, Number, Param};
+use super::{FairOptions, FairStatus, HistoryRow, Move, Outcome};
 use crate::curve::Curve;
 use crate::error::{Error, Result};
 use crate::geom::{BBox, Point, PointSeq};
@@ -457,40 +458,61 @@ pub(crate) fn resolve_tolerance(tolerance: Option<f64>, curve: &BSplineCurve) ->
     }
 }
 
-/// Parameters shared by both methods for point input.
-pub(crate) const FIT_PARAMS: [ParamSpec; 3] = [
-    ParamSpec {
-        name: "degree",
-        default: "3",
-        doc: "degree of the B-spline fitted to point input (2..=5)",
+/// The degree of the B-spline fitted to point input ([`DEFAULT_FIT_DEGREE`]).
+pub(crate) const FIT_DEGREE: Param<Number<usize>> = Param {
+    name: "degree",
+    kind: Number {
+        default: DEFAULT_FIT_DEGREE,
+        min: 2,
+        max: 5,
     },
-    ParamSpec {
-        name: "control_points",
-        default: "auto",
-        doc: "auto: interpolate the points; N: least-squares fit with N control points",
-    },
-    ParamSpec {
-        name: "free_ends",
-        default: "false",
-        doc: "let the first and last control points move too (ignored with --fix-ends)",
-    },
-];
+    doc: "degree of the B-spline fitted to point input (2..=5)",
+};
 
-/// Check the values of [`FIT_PARAMS`] without an input: the degree, the control-point count
-/// against the degree (the bound by the number of points is checked by [`fit_input`]), and
-/// `free_ends`.
+/// The control points of the fit to point input (`auto`: interpolate); more than the degree,
+/// and at most the number of points ([`fit_input`] narrows the range to the input's).
+pub(crate) const CONTROL_POINTS: Param<Auto<usize>> = Param {
+    name: "control_points",
+    kind: Auto {
+        min: FIT_DEGREE.kind.min + 1,
+        max: usize::MAX,
+    },
+    doc: "auto: interpolate the points; N: least-squares fit with N control points",
+};
+
+/// Let the end control points move ([`FittedInput::free_ends`]).
+pub(crate) const FREE_ENDS: Param<Flag> = Param {
+    name: "free_ends",
+    kind: Flag { default: false },
+    doc: "let the first and last control points move too (ignored with --fix-ends)",
+};
+
+/// The length R of the recently-moved list ([`DEFAULT_TABU_LENGTH`]).
+pub(crate) const TABU: Param<Number<usize>> = Param {
+    name: "tabu",
+    kind: Number {
+        default: DEFAULT_TABU_LENGTH,
+        min: 0,
+        max: 1000,
+    },
+    doc: "length R of the recently-moved list",
+};
+
+/// Check the values of the fit parameters ([`FIT_DEGREE`], [`CONTROL_POINTS`], [`FREE_ENDS`])
+/// without an input: the degree, the control-point count against the degree (the bound by the
+/// number of points is checked by [`fit_input`]), and `free_ends`.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`].
 pub(crate) fn check_fit_params(options: &FairOptions) -> Result<()> {
     let degree = fit_degree(options)?;
-    options.param_auto_usize_in("control_points", degree + 1, usize::MAX)?;
-    options.param_bool("free_ends", false).map(|_| ())
+    options.get(&CONTROL_POINTS.within(degree + 1, usize::MAX))?;
+    options.get(&FREE_ENDS).map(|_| ())
 }
 
 /// The `degree` of the B-spline fitted to point input, 2..=5.
 pub(crate) fn fit_degree(options: &FairOptions) -> Result<usize> {
-    options.param_usize_in("degree", DEFAULT_FIT_DEGREE, 2, 5)
+    options.get(&FIT_DEGREE)
 }
 
 /// Point input fitted with a B-spline, and what the fit means for the tolerance.
@@ -529,25 +551,25 @@ pub(crate) fn fit_input(input: &PointSeq, options: &FairOptions) -> Result<Fitte
     let degree = fit_degree(options)?;
     let mut notes = Vec::new();
     let mut parameters = serde_json::Map::new();
-    let (curve, params, fit) =
-        match options.param_auto_usize_in("control_points", degree + 1, points.len())? {
-            None => {
-                let (c, t) =
-                    BSplineCurve::interpolate(points, degree, Parametrization::ChordLength)?;
-                (c, t, "interpolation")
-            }
-            Some(n) => {
-                let (c, t) =
-                    BSplineCurve::approximate(points, degree, n, Parametrization::ChordLength)?;
-                (c, t, "least_squares")
-            }
-        };
+    let (curve, params, fit) = match options
+        .get(&CONTROL_POINTS.within(degree + 1, points.len()))?
+    {
+        None => {
+            let (c, t) = BSplineCurve::interpolate(points, degree, Parametrization::ChordLength)?;
+            (c, t, "interpolation")
+        }
+        Some(n) => {
+            let (c, t) =
+                BSplineCurve::approximate(points, degree, n, Parametrization::ChordLength)?;
+            (c, t, "least_squares")
+        }
+    };
     let residual = points
         .iter()
         .zip(&params)
         .map(|(q, &t)| q.distance(curve.eval(t)))
         .fold(0.0, f64::max);
-    let free = options.param_bool("free_ends", false)?;
+    let free = options.get(&FREE_ENDS)?;
     if free && options.fix_ends.is_fixed() {
         notes.push("free_ends is ignored because the ends are fixed (--fix-ends)".to_string());
     }
@@ -581,11 +603,11 @@ pub(crate) fn fit_input(input: &PointSeq, options: &FairOptions) -> Result<Fitte
         }
     };
     parameters.insert("fit".into(), fit.into());
-    parameters.insert("degree".into(), degree.into());
-    parameters.insert("control_points".into(), curve.control_points().len().into());
+    FIT_DEGREE.write(&mut parameters, degree);
+    CONTROL_POINTS.write(&mut parameters, Some(curve.control_points().len()));
     parameters.insert("fit_residual".into(), json_f64(residual));
     parameters.insert("delta".into(), json_f64(delta));
-    parameters.insert("free_ends".into(), free_ends.into());
+    FREE_ENDS.write(&mut parameters, free_ends);
     Ok(FittedInput {
         curve,
         params,
@@ -615,7 +637,7 @@ pub(crate) fn curve_input(
     let params = curve.knots().greville(p);
     let seq = PointSeq::open(params.iter().map(|&t| curve.eval(t)).collect())?;
     let mut notes = Vec::new();
-    let free = options.param_bool("free_ends", false)?;
+    let free = options.get(&FREE_ENDS)?;
     let free_ends = free && !options.fix_ends.is_fixed();
     let delta = match options.tolerance {
         Some(tol) => tol,
@@ -630,10 +652,10 @@ pub(crate) fn curve_input(
     };
     let mut parameters = serde_json::Map::new();
     parameters.insert("fit".into(), "none (B-spline input)".into());
-    parameters.insert("degree".into(), p.into());
-    parameters.insert("control_points".into(), n.into());
+    FIT_DEGREE.write(&mut parameters, p);
+    CONTROL_POINTS.write(&mut parameters, Some(n));
     parameters.insert("delta".into(), json_f64(delta));
-    parameters.insert("free_ends".into(), free_ends.into());
+    FREE_ENDS.write(&mut parameters, free_ends);
     Ok((
         FittedInput {
             curve: curve.clone(),

@@ -7,8 +7,9 @@
 //! every report has in common: displacements, metrics before and after, whether the tolerance
 //! held, elapsed time.
 //!
-//! Adding a method: implement [`FairMethod`] in a file of its own under `fair/` and list it
-//! in [`methods`].
+//! Adding a method: implement [`FairMethod`] in a file of its own under `fair/`, declare each
+//! of its parameters once as a `Param` constant (`params.rs`: key, kind with default and
+//! range, doc) and list it in [`methods`].
 
 pub mod band;
 pub mod cali;
@@ -23,6 +24,7 @@ pub mod kjellander;
 pub mod kuragano;
 pub mod local;
 mod options;
+mod params;
 mod periodic;
 mod report;
 pub mod salvi;
@@ -37,7 +39,7 @@ use std::time::Instant;
 
 pub use band::{Band, auto_k as band_tolerance_factor};
 pub use cali::Cali;
-pub use catalogue::{MethodInfo, ParamInfo, ParamType, catalogue};
+pub use catalogue::{MethodInfo, ParamInfo, catalogue};
 pub use clean::LOCAL_CHECK_HALF_WIDTH;
 pub use compare::{Comparison, ComparisonOutcome, ComparisonRow, compare};
 pub use eck_hadenfeld::EckHadenfeld;
@@ -46,7 +48,8 @@ pub use han::Han;
 pub use kjellander::{
     Energy, HermiteMove, Kjellander, KpRule, Poliakoff, fair_hermite, hermite_step,
 };
-pub use options::{AUTO_TOLERANCE_K, EndFix, FairOptions, MAX_ITERATIONS, ParamSpec};
+pub use options::{AUTO_TOLERANCE_K, EndFix, FairOptions, MAX_ITERATIONS};
+pub use params::{ParamDefault, ParamSpec, ParamType};
 pub use report::{
     EndChanges, FairReport, FairStatus, HistoryRow, Move, SolverInfo, ToleranceSource,
 };

@@ -4,6 +4,7 @@ use std::str::FromStr;
 
 use serde::Serialize;
 
+use super::params::{Kind, Param};
 use crate::error::{Error, Result};
 
 /// What `--fix-ends` keeps at the two ends of an open curve: nothing, the end points
@@ -126,7 +127,7 @@ pub struct FairOptions {
     /// Default value: `None`.
     pub max_iterations: Option<usize>,
     /// Method parameters as `key = value` text (from `--set key=value`), checked against the
-    /// method's [`ParamSpec`]s.
+    /// method's [`ParamSpec`](super::ParamSpec)s.
     ///
     /// Default value: empty.
     pub params: BTreeMap<String, String>,
@@ -229,142 +230,13 @@ impl FairOptions {
         self.max_iterations.unwrap_or(default)
     }
 
-    /// A numeric parameter, or `None` when it was not set.
+    /// The value of the method parameter `param` ([`Param`]): its default when it is not
+    /// given, else the given text read as its kind and checked against its range.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] when the text is not a finite number.
-    pub fn param_f64(&self, key: &str) -> Result<Option<f64>> {
-        match self.params.get(key) {
-            None => Ok(None),
-            Some(s) => match s.trim().parse::<f64>() {
-                Ok(v) if v.is_finite() => Ok(Some(v)),
-                _ => Err(Error::InvalidParameter {
-                    name: key.into(),
-                    reason: format!("'{s}' is not a finite number"),
-                }),
-            },
-        }
-    }
-
-    /// A numeric parameter with a default, checked to lie in `[lo, hi]`.
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] when it is not a number or out of range.
-    pub fn param_f64_in(&self, key: &str, default: f64, lo: f64, hi: f64) -> Result<f64> {
-        let v = self.param_f64(key)?.unwrap_or(default);
-        if !(lo..=hi).contains(&v) {
-            return Err(Error::InvalidParameter {
-                name: key.into(),
-                reason: range_reason(v, lo, hi),
-            });
-        }
-        Ok(v)
-    }
-
-    /// A non-negative integer parameter with a default, checked to lie in `[lo, hi]`.
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] when it is not a whole number or out of range.
-    pub fn param_usize_in(&self, key: &str, default: usize, lo: usize, hi: usize) -> Result<usize> {
-        let v = match self.params.get(key) {
-            None => default,
-            Some(s) => s
-                .trim()
-                .parse::<usize>()
-                .map_err(|_| Error::InvalidParameter {
-                    name: key.into(),
-                    reason: format!("'{s}' is not a whole number"),
-                })?,
-        };
-        if !(lo..=hi).contains(&v) {
-            return Err(Error::InvalidParameter {
-                name: key.into(),
-                reason: format!("{v} is outside [{lo}, {hi}]"),
-            });
-        }
-        Ok(v)
-    }
-
-    /// Whether the parameter `key` is left to the method: not given, or `auto`.
-    pub fn param_is_auto(&self, key: &str) -> bool {
-        matches!(self.params.get(key).map(|s| s.trim()), None | Some("auto"))
-    }
-
-    /// A number in `[lo, hi]`, or `None` when the parameter is not given or `auto`.
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] for a value that is not a number or out of range.
-    pub fn param_auto_f64_in(&self, key: &str, lo: f64, hi: f64) -> Result<Option<f64>> {
-        if self.param_is_auto(key) {
-            return Ok(None);
-        }
-        self.param_f64_in(key, lo, lo, hi).map(Some)
-    }
-
-    /// A count in `[lo, hi]`, or `None` when the parameter is not given or `auto`.
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] for a value that is not a count or out of range.
-    pub fn param_auto_usize_in(&self, key: &str, lo: usize, hi: usize) -> Result<Option<usize>> {
-        if self.param_is_auto(key) {
-            return Ok(None);
-        }
-        self.param_usize_in(key, lo, lo, hi).map(Some)
-    }
-
-    /// A boolean method parameter, with a default: `true/false`, `yes/no`, `1/0`, `on/off`
-    /// (any case), the same for every method.
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] for anything else.
-    pub fn param_bool(&self, key: &str, default: bool) -> Result<bool> {
-        match self.params.get(key).map(|s| s.trim().to_ascii_lowercase()) {
-            None => Ok(default),
-            Some(s) => match s.as_str() {
-                "true" | "yes" | "1" | "on" => Ok(true),
-                "false" | "no" | "0" | "off" => Ok(false),
-                _ => Err(Error::InvalidParameter {
-                    name: key.into(),
-                    reason: format!("'{s}' is not a boolean (true/false)"),
-                }),
-            },
-        }
-    }
-
-    /// A parameter that must be one of `choices`, with a default.
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] naming the allowed values.
-    pub fn param_choice(
-        &self,
-        key: &str,
-        default: &'static str,
-        choices: &[&'static str],
-    ) -> Result<&'static str> {
-        match self.params.get(key) {
-            None => Ok(default),
-            Some(s) => choices
-                .iter()
-                .copied()
-                .find(|c| *c == s.trim())
-                .ok_or_else(|| Error::InvalidParameter {
-                    name: key.into(),
-                    reason: format!("'{s}' is not one of {}", choices.join(", ")),
-                }),
-        }
-    }
-}
-
-/// Why `v` is not in `[lo, hi]`, in words short enough for one line: the open ends of the
-/// `f64` range (`f64::MIN_POSITIVE`, `f64::MAX`) are said as "positive" and "at least", not
-/// printed as 300-digit numbers; other bounds in their shortest exact form.
-fn range_reason(v: f64, lo: f64, hi: f64) -> String {
-    let num = crate::io::format_f64;
-    match (lo == f64::MIN_POSITIVE, hi == f64::MAX) {
-        (true, true) => format!("must be a positive number, got {}", num(v)),
-        (false, true) => format!("must be at least {}, got {}", num(lo), num(v)),
-        (true, false) => format!("must be positive and at most {}, got {}", num(hi), num(v)),
-        (false, false) => format!("{} is outside [{}, {}]", num(v), num(lo), num(hi)),
+    /// [`Error::InvalidParameter`] naming the parameter.
+    pub(crate) fn get<K: Kind + 'static>(&self, param: &Param<K>) -> Result<K::Value> {
+        param.read(self.params.get(param.name).map(String::as_str))
     }
 }
 
@@ -374,41 +246,9 @@ impl Default for FairOptions {
     }
 }
 
-/// Description of one method parameter, for validation and `batten methods`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ParamSpec {
-    /// The key used in `--set key=value`.
-    pub name: &'static str,
-    /// The default, as text ("auto" where it is computed).
-    pub default: &'static str,
-    /// One line on what it does.
-    pub doc: &'static str,
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Every method's boolean parameters take the same spellings (one parser).
-    #[test]
-    fn booleans_are_read_one_way() {
-        for (v, want) in [
-            ("true", true),
-            ("Yes", true),
-            ("1", true),
-            (" on ", true),
-            ("FALSE", false),
-            ("no", false),
-            ("0", false),
-            ("off", false),
-        ] {
-            let o = FairOptions::default().with_param("flag", v);
-            assert_eq!(o.param_bool("flag", !want).unwrap(), want, "{v}");
-        }
-        assert!(FairOptions::default().param_bool("flag", true).unwrap());
-        let bad = FairOptions::default().with_param("flag", "maybe");
-        assert!(bad.param_bool("flag", true).is_err());
-    }
 
     fn reason(o: &FairOptions) -> String {
         match o.validate() {
@@ -435,30 +275,6 @@ mod tests {
         assert_eq!(
             reason(&o.with_max_iterations(usize::MAX)),
             "18446744073709551615 is outside [0, 1000000]"
-        );
-    }
-
-    #[test]
-    fn range_reasons_stay_short() {
-        let o = FairOptions::default().with_param("g", 0);
-        let e = o.param_f64_in("g", 1.0, f64::MIN_POSITIVE, f64::MAX);
-        assert!(
-            matches!(&e, Err(Error::InvalidParameter { reason, .. })
-                if reason == "must be a positive number, got 0"),
-            "{e:?}"
-        );
-        assert_eq!(
-            range_reason(-1.0, 0.5, f64::MAX),
-            "must be at least 0.5, got -1"
-        );
-        assert_eq!(
-            range_reason(3.0, f64::MIN_POSITIVE, 2.0),
-            "must be positive and at most 2, got 3"
-        );
-        assert_eq!(range_reason(2.0, 0.0, 1.0), "2 is outside [0, 1]");
-        assert_eq!(
-            range_reason(1e300, -1e-7, 1.0),
-            "1e300 is outside [-1e-7, 1]"
         );
     }
 }

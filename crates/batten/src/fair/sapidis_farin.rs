@@ -93,8 +93,8 @@
 use serde_json::json;
 
 use super::engine::{
-    EPSILON_PARAM, JUMP_ZERO_REL, LocalProblem, MIN_CHORD_REL, MaxTree, THRESHOLD_PARAM, Threshold,
-    drive, driven_parameters, max_fraction, move_limit, tolerance_radius,
+    EPSILON, JUMP_PARAMS, JUMP_ZERO_REL, LocalProblem, MIN_CHORD_REL, MaxTree, Threshold, drive,
+    driven_parameters, max_fraction, move_limit, tolerance_radius,
 };
 pub use super::periodic::MIN_CLOSED_POINTS;
 use super::periodic::{PAD, interpolate_closed, period_index};
@@ -398,7 +398,7 @@ impl LocalProblem for KnotState {
 /// Parameters in data units and their power of length: the B-spline's third-derivative
 /// jumps (on the averaging knots of the chord-length parameters, as the method measures them)
 /// scale as a length.
-const LENGTH_PARAMS: &[(&str, i32)] = &[("epsilon", 1), ("initial_max_jump", 1)];
+const LENGTH_PARAMS: &[(&str, i32)] = &[(EPSILON.name, 1), ("initial_max_jump", 1)];
 
 impl FairMethod for SapidisFarin {
     fn name(&self) -> &'static str {
@@ -410,7 +410,7 @@ impl FairMethod for SapidisFarin {
     }
 
     fn parameters(&self) -> &'static [ParamSpec] {
-        &[THRESHOLD_PARAM, EPSILON_PARAM]
+        &JUMP_PARAMS
     }
 
     fn supports_closed(&self) -> bool {

@@ -402,7 +402,7 @@ fn alpha_of(p: f64) -> f64 {
 
 /// The `p` parameter: `None` for `auto` (or not given), else a number in [0, 1].
 pub(crate) fn param_p(options: &FairOptions) -> Result<Option<f64>> {
-    options.param_auto_f64_in("p", 0.0, 1.0)
+    options.get(&super::smoothing_mst::P)
 }
 
 pub(crate) fn check_p(p: f64, closed: bool) -> Result<()> {

@@ -13,13 +13,18 @@ use crate::error::Result;
 use crate::geom::{Point, PointSeq, SpaceSeq, Xyz};
 use crate::spline::{Parametrization, parameters};
 
-/// The parameter list of [`Mst`].
-static PARAMS: &[ParamSpec] = &[ParamSpec {
+use super::params::{Auto, Param};
+
+/// The smoothing parameter p (`auto`: chosen for the tolerance, or by GCV).
+pub(crate) const P: Param<Auto<f64>> = Param {
     name: "p",
-    default: "auto",
+    kind: Auto { min: 0.0, max: 1.0 },
     doc: "smoothing parameter in [0, 1] (1 interpolates, 0 is the least-squares line); \
           auto: the smoothest within --tolerance, else generalised cross-validation",
-}];
+};
+
+/// The parameter list of [`Mst`].
+static PARAMS: &[ParamSpec] = &[P.spec()];
 
 /// The `mst` fairing method: the cubic smoothing spline of the points at chord-length
 /// parameters, with p given (`--set p=…`), chosen for `--tolerance`, or by GCV. See the module
@@ -75,7 +80,7 @@ impl FairMethod for Mst {
         let mut o = options.clone();
         if let Some(p) = param_p(options)? {
             o.params
-                .insert("p".into(), format!("{:e}", p_at_scale(p, 1.0 / s)));
+                .insert(P.name.into(), format!("{:e}", p_at_scale(p, 1.0 / s)));
         }
         Ok(o)
     }
@@ -85,8 +90,8 @@ impl FairMethod for Mst {
         parameters: &mut serde_json::Map<String, serde_json::Value>,
         s: f64,
     ) {
-        if let Some(p) = parameters.get("p").and_then(serde_json::Value::as_f64) {
-            parameters.insert("p".into(), json_f64(p_at_scale(p, s)));
+        if let Some(p) = parameters.get(P.name).and_then(serde_json::Value::as_f64) {
+            P.write(parameters, Some(p_at_scale(p, s)));
         }
     }
 
@@ -171,7 +176,7 @@ fn run_points<const D: usize>(
     };
     let (fit, info) = select_any(t, points, weights.as_deref(), closed, how)?;
     let mut parameters = Map::new();
-    parameters.insert("p".into(), json_f64(info.p));
+    P.write(&mut parameters, Some(info.p));
     parameters.insert("alpha".into(), json_f64(info.alpha));
     parameters.insert("selection".into(), Value::from(selection));
     if let Some(g) = info.gcv {

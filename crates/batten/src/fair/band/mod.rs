@@ -62,8 +62,6 @@ mod working_set;
 #[cfg(test)]
 mod reference_tests;
 
-use serde_json::{Map, Value};
-
 use crate::error::{Error, Result};
 use crate::fair::{
     AUTO_TOLERANCE_K, FairMethod, FairOptions, FairStatus, HistoryRow, Outcome, ParamSpec,
@@ -200,25 +198,7 @@ fn run_points<const D: usize>(
     let held = held_mask(pts.len(), closed, options.fix_ends.held());
     let (noise, noise_dims) = noise();
     let faired = fair_points(pts, closed, &held, tolerance, (noise, noise_dims), &params)?;
-    let mut parameters = Map::new();
-    match params.k {
-        Some(k) => parameters.insert("k".into(), Value::from(k)),
-        None => parameters.insert("k".into(), Value::from("auto")),
-    };
-    parameters.insert(
-        "energy".into(),
-        Value::from(match params.metric {
-            Metric::Jerk => "jerk",
-            Metric::MinVariation { .. } => "min-variation",
-        }),
-    );
-    if let Metric::MinVariation { eps, speed } = params.metric {
-        parameters.insert("eps".into(), Value::from(eps));
-        parameters.insert("speed".into(), Value::from(speed));
-    }
-    parameters.insert("passes".into(), Value::from(params.passes));
-    parameters.insert("fit".into(), Value::from(params.fit));
-    parameters.insert("local".into(), Value::from(params.local));
+    let parameters = params.report();
     let mut notes: Vec<String> = faired
         .fidelity
         .map(|(mu, raised)| {

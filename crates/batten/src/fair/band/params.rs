@@ -1,6 +1,9 @@
 //! `band`'s parameters, typed, with their defaults and ranges in one place.
 
+use serde_json::{Map, Value};
+
 use crate::error::Result;
+use crate::fair::params::{Auto, Choice, Number, Param};
 use crate::fair::{FairOptions, ParamSpec};
 
 use super::energy::Metric;
@@ -20,43 +23,90 @@ pub const DEFAULT_FIT: f64 = 1.25;
 /// Default interior-point iterations per pass (`--max-iterations`).
 pub const DEFAULT_MAX_ITERATIONS: usize = 200;
 
-/// The parameter table (`batten methods`).
-pub(super) const PARAMS: &[ParamSpec] = &[
-    ParamSpec {
-        name: "k",
-        default: "auto",
-        doc: "automatic tolerance D = k·σ̂ (σ̂ the noise estimate), used when no tolerance is given; auto = max(3, √(2 ln n)), or a number in (0, 100]",
+/// The factor of the automatic tolerance (`auto`: [`super::auto_k`]).
+pub(super) const K: Param<Auto<f64>> = Param {
+    name: "k",
+    kind: Auto {
+        min: f64::MIN_POSITIVE,
+        max: 100.0,
     },
-    ParamSpec {
-        name: "energy",
+    doc: "automatic tolerance D = k·σ̂ (σ̂ the noise estimate), used when no tolerance is given; auto = max(3, √(2 ln n)), or a number in (0, 100]",
+};
+
+/// The energy of the passes after the first.
+pub(super) const ENERGY: Param<Choice> = Param {
+    name: "energy",
+    kind: Choice {
         default: "min-variation",
-        doc: "min-variation (curvature variation off the tangent, re-weighted over the passes) or jerk (|C'''|²)",
+        choices: &["min-variation", "jerk"],
     },
-    ParamSpec {
-        name: "eps",
-        default: "0.02",
-        doc: "weight of the full jerk inside the min-variation energy, for regularity; [0, 10]",
+    doc: "min-variation (curvature variation off the tangent, re-weighted over the passes) or jerk (|C'''|²)",
+};
+
+/// The weight of the full jerk ([`DEFAULT_EPS`]).
+pub(super) const EPS: Param<Number<f64>> = Param {
+    name: "eps",
+    kind: Number {
+        default: DEFAULT_EPS,
+        min: 0.0,
+        max: 10.0,
     },
-    ParamSpec {
-        name: "speed",
-        default: "0",
-        doc: "weight of the speed term inside the min-variation energy (the tangential second difference: keeps points from crowding where the curvature peaks); [0, 1e6]",
+    doc: "weight of the full jerk inside the min-variation energy, for regularity; [0, 10]",
+};
+
+/// The weight of the speed term ([`DEFAULT_SPEED`]).
+pub(super) const SPEED: Param<Number<f64>> = Param {
+    name: "speed",
+    kind: Number {
+        default: DEFAULT_SPEED,
+        min: 0.0,
+        max: 1e6,
     },
-    ParamSpec {
-        name: "fit",
-        default: "1.25",
-        doc: "debiasing: the last stage moves back towards the data until the mean residual is fit·σ̂ per coordinate; 0 turns it off; [0, 10]",
+    doc: "weight of the speed term inside the min-variation energy (the tangential second difference: keeps points from crowding where the curvature peaks); [0, 1e6]",
+};
+
+/// The debiasing stage's residual target ([`DEFAULT_FIT`]).
+pub(super) const FIT: Param<Number<f64>> = Param {
+    name: "fit",
+    kind: Number {
+        default: DEFAULT_FIT,
+        min: 0.0,
+        max: 10.0,
     },
-    ParamSpec {
-        name: "local",
-        default: "2",
-        doc: "debiasing: the data weight is raised where the residual's mean over the smoothing length exceeds local·σ̂/√count (a flattened feature); 0 turns it off; [0, 100]",
+    doc: "debiasing: the last stage moves back towards the data until the mean residual is fit·σ̂ per coordinate; 0 turns it off; [0, 10]",
+};
+
+/// The significance of a biased window ([`DEFAULT_LOCAL`]).
+pub(super) const LOCAL: Param<Number<f64>> = Param {
+    name: "local",
+    kind: Number {
+        default: DEFAULT_LOCAL,
+        min: 0.0,
+        max: 100.0,
     },
-    ParamSpec {
-        name: "passes",
-        default: "3",
-        doc: "solves, each re-taking parameters and tangents from the previous result; 1..=10",
+    doc: "debiasing: the data weight is raised where the residual's mean over the smoothing length exceeds local·σ̂/√count (a flattened feature); 0 turns it off; [0, 100]",
+};
+
+/// The number of passes ([`DEFAULT_PASSES`]).
+pub(super) const PASSES: Param<Number<usize>> = Param {
+    name: "passes",
+    kind: Number {
+        default: DEFAULT_PASSES,
+        min: 1,
+        max: 10,
     },
+    doc: "solves, each re-taking parameters and tangents from the previous result; 1..=10",
+};
+
+/// The parameter table (`batten methods`).
+pub(super) static PARAMS: &[ParamSpec] = &[
+    K.spec(),
+    ENERGY.spec(),
+    EPS.spec(),
+    SPEED.spec(),
+    FIT.spec(),
+    LOCAL.spec(),
+    PASSES.spec(),
 ];
 
 /// The parameters as used.
@@ -83,18 +133,17 @@ impl BandParams {
     /// # Errors
     /// [`crate::Error::InvalidParameter`] naming the parameter and its range.
     pub fn from_options(options: &FairOptions) -> Result<BandParams> {
-        let k = options.param_auto_f64_in("k", f64::MIN_POSITIVE, 100.0)?;
-        let eps = options.param_f64_in("eps", DEFAULT_EPS, 0.0, 10.0)?;
-        let speed = options.param_f64_in("speed", DEFAULT_SPEED, 0.0, 1e6)?;
-        let metric =
-            match options.param_choice("energy", "min-variation", &["min-variation", "jerk"])? {
-                "jerk" => Metric::Jerk,
-                _ => Metric::MinVariation { eps, speed },
-            };
-        let passes = options.param_usize_in("passes", DEFAULT_PASSES, 1, 10)?;
+        let k = options.get(&K)?;
+        let eps = options.get(&EPS)?;
+        let speed = options.get(&SPEED)?;
+        let metric = match options.get(&ENERGY)? {
+            "jerk" => Metric::Jerk,
+            _ => Metric::MinVariation { eps, speed },
+        };
+        let passes = options.get(&PASSES)?;
         let max_iterations = options.iterations_or(DEFAULT_MAX_ITERATIONS);
-        let fit = options.param_f64_in("fit", DEFAULT_FIT, 0.0, 10.0)?;
-        let local = options.param_f64_in("local", DEFAULT_LOCAL, 0.0, 100.0)?;
+        let fit = options.get(&FIT)?;
+        let local = options.get(&LOCAL)?;
         Ok(BandParams {
             local,
             k,
@@ -103,5 +152,25 @@ impl BandParams {
             max_iterations,
             fit,
         })
+    }
+
+    /// The parameters as used, for the report.
+    pub fn report(&self) -> Map<String, Value> {
+        let mut parameters = Map::new();
+        let p = &mut parameters;
+        K.write(p, self.k);
+        let energy = match self.metric {
+            Metric::Jerk => "jerk",
+            Metric::MinVariation { .. } => "min-variation",
+        };
+        ENERGY.write(p, energy);
+        if let Metric::MinVariation { eps, speed } = self.metric {
+            EPS.write(p, eps);
+            SPEED.write(p, speed);
+        }
+        PASSES.write(p, self.passes);
+        FIT.write(p, self.fit);
+        LOCAL.write(p, self.local);
+        parameters
     }
 }

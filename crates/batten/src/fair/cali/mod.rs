@@ -107,6 +107,7 @@
 mod indicators;
 mod run;
 
+use super::params::{Number, Param};
 use super::{FairMethod, FairOptions, Outcome, ParamSpec};
 use crate::error::{Error, Result};
 use crate::geom::PointSeq;
@@ -132,23 +133,40 @@ pub const MAX_MOVES_PER_POINT: usize = 50;
 /// The smallest allowed `lambda_tol`: below it the golden section only resolves rounding.
 const MIN_LAMBDA_TOL: f64 = 1e-12;
 
-static PARAMS: &[ParamSpec] = &[
-    ParamSpec {
-        name: "tau",
-        default: "0.99",
-        doc: "accept a move when GFI_new < tau * GFI, 0 < tau <= 1 (paper: 0.99)",
+/// τ ([`DEFAULT_TAU`]).
+const TAU: Param<Number<f64>> = Param {
+    name: "tau",
+    kind: Number {
+        default: DEFAULT_TAU,
+        min: 0.0,
+        max: 1.0,
     },
-    ParamSpec {
-        name: "lambda_tol",
-        default: "1e-6",
-        doc: "tolerance in lambda of the golden-section search on [0, 1]",
+    doc: "accept a move when GFI_new < tau * GFI, 0 < tau <= 1 (paper: 0.99)",
+};
+
+/// The golden section's tolerance in λ ([`DEFAULT_LAMBDA_TOL`]).
+const LAMBDA_TOL: Param<Number<f64>> = Param {
+    name: "lambda_tol",
+    kind: Number {
+        default: DEFAULT_LAMBDA_TOL,
+        min: MIN_LAMBDA_TOL,
+        max: 0.5,
     },
-    ParamSpec {
-        name: "degree",
-        default: "3",
-        doc: "degree of the interpolating B-spline, 2..=7",
+    doc: "tolerance in lambda of the golden-section search on [0, 1]",
+};
+
+/// The spline degree ([`DEFAULT_DEGREE`]).
+const DEGREE: Param<Number<usize>> = Param {
+    name: "degree",
+    kind: Number {
+        default: DEFAULT_DEGREE,
+        min: 2,
+        max: MAX_ORDER - 1,
     },
-];
+    doc: "degree of the interpolating B-spline, 2..=7",
+};
+
+static PARAMS: &[ParamSpec] = &[TAU.spec(), LAMBDA_TOL.spec(), DEGREE.spec()];
 
 /// The `cali` fairing method (see the module documentation).
 #[derive(Clone, Copy, Debug, Default)]
@@ -156,15 +174,15 @@ pub struct Cali;
 
 /// `tau`, `lambda_tol` and `degree`, checked.
 fn cali_params(options: &FairOptions) -> Result<(f64, f64, usize)> {
-    let tau = options.param_f64_in("tau", DEFAULT_TAU, 0.0, 1.0)?;
+    let tau = options.get(&TAU)?;
     if tau <= 0.0 {
         return Err(Error::InvalidParameter {
             name: "tau".into(),
             reason: "must be positive (no move can make the GFI negative)".into(),
         });
     }
-    let lambda_tol = options.param_f64_in("lambda_tol", DEFAULT_LAMBDA_TOL, MIN_LAMBDA_TOL, 0.5)?;
-    let degree = options.param_usize_in("degree", DEFAULT_DEGREE, 2, MAX_ORDER - 1)?;
+    let lambda_tol = options.get(&LAMBDA_TOL)?;
+    let degree = options.get(&DEGREE)?;
     Ok((tau, lambda_tol, degree))
 }
 

@@ -8,6 +8,7 @@ use std::collections::BTreeSet;
 use serde_json::{Map, Value};
 
 use super::indicators::{LocalIndicators, Trial};
+use super::{DEGREE, LAMBDA_TOL, TAU};
 use crate::error::Result;
 use crate::fair::{FairStatus, HistoryRow, Move, Outcome};
 use crate::geom::{Point, Vec2};
@@ -53,9 +54,9 @@ pub(super) fn run_cali(points: &[Point], s: &Settings) -> Result<Outcome> {
     let data = DataSamples::new(&curve, &params, points);
 
     let mut parameters = Map::new();
-    parameters.insert("tau".into(), Value::from(s.tau));
-    parameters.insert("lambda_tol".into(), Value::from(s.lambda_tol));
-    parameters.insert("degree".into(), Value::from(s.degree));
+    TAU.write(&mut parameters, s.tau);
+    LAMBDA_TOL.write(&mut parameters, s.lambda_tol);
+    DEGREE.write(&mut parameters, s.degree);
     parameters.insert("max_moves".into(), Value::from(s.max_moves));
     parameters.insert("parametrization".into(), Value::from("chord_length"));
     parameters.insert("gfi_initial".into(), Value::from(state.gfi()));

@@ -7,6 +7,7 @@
 use serde_json::{Map, Value, json};
 
 use crate::error::{Error, Result};
+use crate::fair::params::{Auto, Number, Param};
 use crate::fair::{FairOptions, FairStatus, HistoryRow, Move, ParamSpec};
 
 /// Default relative stopping threshold: the run stops when every `|J_k|` is at most this
@@ -44,34 +45,37 @@ impl Threshold {
     /// Read the `threshold` and `epsilon` method parameters (`epsilon=auto`, the documented
     /// default, is the same as leaving it out).
     pub(crate) fn from_options(options: &FairOptions) -> Result<Threshold> {
-        let rel = options.param_f64_in("threshold", DEFAULT_THRESHOLD, 0.0, 1.0)?;
-        if options.param_is_auto("epsilon") {
-            return Ok(Threshold::Relative(rel));
-        }
-        match options.param_f64("epsilon")? {
-            Some(e) if e < 0.0 => Err(Error::InvalidParameter {
-                name: "epsilon".into(),
-                reason: format!("must be non-negative, got {e}"),
-            }),
-            Some(e) => Ok(Threshold::Absolute(e)),
-            None => Ok(Threshold::Relative(rel)),
-        }
+        let rel = options.get(&THRESHOLD)?;
+        Ok(match options.get(&EPSILON)? {
+            Some(e) => Threshold::Absolute(e),
+            None => Threshold::Relative(rel),
+        })
     }
 }
 
-/// Parameter specs shared by every method that runs on the engine.
-pub(crate) const THRESHOLD_PARAM: ParamSpec = ParamSpec {
+/// The relative stopping threshold ([`Threshold::Relative`]).
+pub(crate) const THRESHOLD: Param<Number<f64>> = Param {
     name: "threshold",
-    default: "0.001",
+    kind: Number {
+        default: DEFAULT_THRESHOLD,
+        min: 0.0,
+        max: 1.0,
+    },
     doc: "stop when every third-derivative jump is at most this fraction of the input's largest",
 };
 
-/// See [`THRESHOLD_PARAM`].
-pub(crate) const EPSILON_PARAM: ParamSpec = ParamSpec {
+/// The absolute stopping threshold ([`Threshold::Absolute`]); `auto`: the relative one.
+pub(crate) const EPSILON: Param<Auto<f64>> = Param {
     name: "epsilon",
-    default: "auto",
+    kind: Auto {
+        min: 0.0,
+        max: f64::MAX,
+    },
     doc: "absolute stopping bound on the jumps (overrides threshold); auto = threshold x input max",
 };
+
+/// The parameters of every method that runs on the engine.
+pub(crate) const JUMP_PARAMS: [ParamSpec; 2] = [THRESHOLD.spec(), EPSILON.spec()];
 
 /// The iteration limit: `max_iterations`, or [`DEFAULT_MOVES_PER_POINT`] per candidate.
 pub(crate) fn move_limit(options: &FairOptions, candidates: usize) -> usize {
@@ -386,9 +390,9 @@ pub(crate) fn driven_parameters(
 ) -> Map<String, Value> {
     let mut p = Map::new();
     if let Threshold::Relative(r) = threshold {
-        p.insert("threshold".into(), json!(r));
+        THRESHOLD.write(&mut p, r);
     }
-    p.insert("epsilon".into(), json!(d.epsilon));
+    EPSILON.write(&mut p, Some(d.epsilon));
     p.insert("initial_max_jump".into(), json!(d.initial_max));
     p.insert("max_iterations".into(), json!(max_moves));
     p

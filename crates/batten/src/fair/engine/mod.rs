@@ -17,6 +17,6 @@ pub use greedy::{
     DEFAULT_MOVES_PER_POINT, DEFAULT_THRESHOLD, JUMP_ZERO_REL, MIN_STEP_FRACTION, RETRY_CHANGE_REL,
 };
 pub(crate) use greedy::{
-    EPSILON_PARAM, LocalProblem, MaxTree, THRESHOLD_PARAM, Threshold, drive, driven_parameters,
+    EPSILON, JUMP_PARAMS, LocalProblem, MaxTree, THRESHOLD, Threshold, drive, driven_parameters,
     move_limit,
 };

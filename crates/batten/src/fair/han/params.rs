@@ -3,9 +3,11 @@
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use super::partition::check_max_turn;
+use serde_json::{Map, Value};
+
 use super::segment::SegmentParams;
-use crate::error::{Error, Result};
+use crate::error::Result;
+use crate::fair::params::{Angle, Flag, Number, Param};
 use crate::fair::{FairOptions, ParamSpec};
 
 /// Default damping of coarse case 1, `λ_c` \[PAPER\].
@@ -39,45 +41,90 @@ pub const RECOMMENDED_MAX_TURN: f64 = DEFAULT_MAX_TURN;
 /// Default iterations per segment, T \[CHOICE §1.7.3\].
 pub const DEFAULT_ITERATIONS: usize = 10;
 
+/// `λ_c` ([`DEFAULT_LAMBDA_COARSE`]).
+pub(super) const LAMBDA_COARSE: Param<Number<f64>> = Param {
+    name: "lambda_coarse",
+    kind: Number {
+        default: DEFAULT_LAMBDA_COARSE,
+        min: 0.0,
+        max: 1.0,
+    },
+    doc: "damping λ_c of coarse case 1 (small vibrations), in [0, 1]",
+};
+
+/// `λ_f` ([`DEFAULT_LAMBDA_FINE`]).
+pub(super) const LAMBDA_FINE: Param<Number<f64>> = Param {
+    name: "lambda_fine",
+    kind: Number {
+        default: DEFAULT_LAMBDA_FINE,
+        min: 0.0,
+        max: 1.0,
+    },
+    doc: "weight λ_f of the outer points of the fine (inflection) moves, in [0, 1]",
+};
+
+/// k ([`DEFAULT_OVERLAP`]).
+pub(super) const OVERLAP: Param<Number<usize>> = Param {
+    name: "overlap",
+    kind: Number {
+        default: DEFAULT_OVERLAP,
+        min: 1,
+        max: MAX_OVERLAP,
+    },
+    doc: "points shared by consecutive function segments (k), 1 to 1000000",
+};
+
+/// The pipeline passes ([`DEFAULT_PASSES`]).
+pub(super) const PASSES: Param<Number<usize>> = Param {
+    name: "passes",
+    kind: Number {
+        default: DEFAULT_PASSES,
+        min: 1,
+        max: 10_000,
+    },
+    doc: "pipeline passes (partition, fair, blend)",
+};
+
+/// The partition's turning threshold ([`DEFAULT_MAX_TURN`]).
+pub(super) const MAX_TURN: Param<Angle> = Param {
+    name: "max_turn",
+    kind: Angle {
+        default: DEFAULT_MAX_TURN,
+    },
+    doc: "turning range of a segment in radians, in (0, π]; accepts pi and pi/N; the paper's \
+          value is pi; pi/2 (the spec's recommendation) keeps segments away from vertical slopes",
+};
+
+/// Fine case 3 ([`DEFAULT_FINE_RUN3`]).
+pub(super) const FINE_RUN3: Param<Flag> = Param {
+    name: "fine_run3",
+    kind: Flag {
+        default: DEFAULT_FINE_RUN3,
+    },
+    doc: "extension, not in the paper: also remove runs of three points of one sign of c (fine \
+          case 3); false gives the paper's method",
+};
+
+/// The fine phase's α factor ([`DEFAULT_ALPHA_FACTOR`]).
+pub(super) const ALPHA_FACTOR: Param<Number<f64>> = Param {
+    name: "alpha_factor",
+    kind: Number {
+        default: DEFAULT_ALPHA_FACTOR,
+        min: 0.0,
+        max: 1.0,
+    },
+    doc: "fine phase target α = factor × the smaller-magnitude neighbour of c, in [0, 1]",
+};
+
+/// The parameter table (`batten methods`).
 pub(super) static PARAMS: &[ParamSpec] = &[
-    ParamSpec {
-        name: "lambda_coarse",
-        default: "0.8",
-        doc: "damping λ_c of coarse case 1 (small vibrations), in [0, 1]",
-    },
-    ParamSpec {
-        name: "lambda_fine",
-        default: "0.75",
-        doc: "weight λ_f of the outer points of the fine (inflection) moves, in [0, 1]",
-    },
-    ParamSpec {
-        name: "overlap",
-        default: "5",
-        doc: "points shared by consecutive function segments (k), 1 to 1000000",
-    },
-    ParamSpec {
-        name: "passes",
-        default: "3",
-        doc: "pipeline passes (partition, fair, blend)",
-    },
-    ParamSpec {
-        name: "max_turn",
-        default: "pi/2",
-        doc: "turning range of a segment in radians, in (0, π]; accepts pi and pi/N; the \
-              paper's value is pi; pi/2 (the spec's recommendation) keeps segments away from \
-              vertical slopes",
-    },
-    ParamSpec {
-        name: "fine_run3",
-        default: "true",
-        doc: "extension, not in the paper: also remove runs of three points of one sign of c \
-              (fine case 3); false gives the paper's method",
-    },
-    ParamSpec {
-        name: "alpha_factor",
-        default: "0.2",
-        doc: "fine phase target α = factor × the smaller-magnitude neighbour of c, in [0, 1]",
-    },
+    LAMBDA_COARSE.spec(),
+    LAMBDA_FINE.spec(),
+    OVERLAP.spec(),
+    PASSES.spec(),
+    MAX_TURN.spec(),
+    FINE_RUN3.spec(),
+    ALPHA_FACTOR.spec(),
 ];
 
 /// Parameters of a run, parsed from the options.
@@ -93,73 +140,33 @@ pub(super) struct HanParams {
 impl HanParams {
     pub(super) fn from_options(o: &FairOptions) -> Result<HanParams> {
         let segment = SegmentParams::DEFAULT
-            .with_lambda_coarse(o.param_f64_in("lambda_coarse", DEFAULT_LAMBDA_COARSE, 0.0, 1.0)?)
-            .with_lambda_fine(o.param_f64_in("lambda_fine", DEFAULT_LAMBDA_FINE, 0.0, 1.0)?)
-            .with_alpha_factor(o.param_f64_in("alpha_factor", DEFAULT_ALPHA_FACTOR, 0.0, 1.0)?);
-        let segment = segment.with_fine_run3(o.param_bool("fine_run3", DEFAULT_FINE_RUN3)?);
+            .with_lambda_coarse(o.get(&LAMBDA_COARSE)?)
+            .with_lambda_fine(o.get(&LAMBDA_FINE)?)
+            .with_alpha_factor(o.get(&ALPHA_FACTOR)?)
+            .with_fine_run3(o.get(&FINE_RUN3)?);
         segment.validate()?;
         Ok(HanParams {
             segment,
-            overlap: o.param_usize_in("overlap", DEFAULT_OVERLAP, 1, MAX_OVERLAP)?,
-            passes: o.param_usize_in("passes", DEFAULT_PASSES, 1, 10_000)?,
-            max_turn: param_angle(o, "max_turn", DEFAULT_MAX_TURN)?,
+            overlap: o.get(&OVERLAP)?,
+            passes: o.get(&PASSES)?,
+            max_turn: o.get(&MAX_TURN)?,
             iterations: o.iterations_or(DEFAULT_ITERATIONS),
         })
     }
 
     /// The parameters as used, for the report.
-    pub(super) fn report(&self) -> serde_json::Map<String, serde_json::Value> {
-        let mut parameters = serde_json::Map::new();
-        let num = |v: f64| serde_json::Value::from(v);
-        parameters.insert("lambda_coarse".into(), num(self.segment.lambda_coarse));
-        parameters.insert("lambda_fine".into(), num(self.segment.lambda_fine));
-        parameters.insert("alpha_factor".into(), num(self.segment.alpha_factor));
-        parameters.insert("fine_run3".into(), self.segment.fine_run3.into());
-        parameters.insert("overlap".into(), self.overlap.into());
-        parameters.insert("passes".into(), self.passes.into());
-        parameters.insert("max_turn".into(), num(self.max_turn));
-        parameters.insert("iterations".into(), self.iterations.into());
-        parameters.insert("fix_ends".into(), true.into());
+    pub(super) fn report(&self) -> Map<String, Value> {
+        let mut parameters = Map::new();
+        let p = &mut parameters;
+        LAMBDA_COARSE.write(p, self.segment.lambda_coarse);
+        LAMBDA_FINE.write(p, self.segment.lambda_fine);
+        ALPHA_FACTOR.write(p, self.segment.alpha_factor);
+        FINE_RUN3.write(p, self.segment.fine_run3);
+        OVERLAP.write(p, self.overlap);
+        PASSES.write(p, self.passes);
+        MAX_TURN.write(p, self.max_turn);
+        p.insert("iterations".into(), self.iterations.into());
+        p.insert("fix_ends".into(), true.into());
         parameters
-    }
-}
-
-/// An angle parameter: a number of radians, `pi`/`π`, or `pi/N`.
-fn param_angle(o: &FairOptions, key: &str, default: f64) -> Result<f64> {
-    let Some(text) = o.params.get(key) else {
-        return Ok(default);
-    };
-    let t = text.trim().to_ascii_lowercase().replace('π', "pi");
-    let bad = || Error::InvalidParameter {
-        name: key.into(),
-        reason: format!("'{text}' is not an angle (radians, pi or pi/N)"),
-    };
-    let v = if t == "pi" {
-        PI
-    } else if let Some(d) = t.strip_prefix("pi/") {
-        PI / d.trim().parse::<f64>().map_err(|_| bad())?
-    } else {
-        t.parse::<f64>().map_err(|_| bad())?
-    };
-    check_max_turn(v)?;
-    Ok(v)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn angle_parameter_forms() {
-        let o = |v: &str| FairOptions::default().with_param("max_turn", v);
-        assert_eq!(param_angle(&o("pi"), "max_turn", 1.0).ok(), Some(PI));
-        assert_eq!(
-            param_angle(&o("π/2"), "max_turn", 1.0).ok(),
-            Some(FRAC_PI_2)
-        );
-        assert_eq!(param_angle(&o(" 1.25 "), "max_turn", 1.0).ok(), Some(1.25));
-        assert!(param_angle(&o("4"), "max_turn", 1.0).is_err());
-        assert!(param_angle(&o("pi/x"), "max_turn", 1.0).is_err());
-        assert!(param_angle(&o("0"), "max_turn", 1.0).is_err());
     }
 }

@@ -5,8 +5,8 @@
 use super::rules::{KpRule, Local, check_hermite, check_unit_steps};
 use crate::error::{Error, Result};
 use crate::fair::engine::{
-    EPSILON_PARAM, LocalProblem, MIN_CHORD_REL, MaxTree, THRESHOLD_PARAM, Threshold, drive,
-    driven_parameters, move_limit, step_fraction,
+    JUMP_PARAMS, LocalProblem, MIN_CHORD_REL, MaxTree, Threshold, drive, driven_parameters,
+    move_limit, step_fraction,
 };
 use crate::fair::{FairOptions, Outcome, ParamSpec};
 use crate::geom::{BBox, Point, Vec2};
@@ -86,7 +86,7 @@ impl LocalProblem for HermiteState {
 }
 
 /// The method parameters [`fair_hermite`] accepts.
-pub const HERMITE_PARAMS: &[ParamSpec] = &[THRESHOLD_PARAM, EPSILON_PARAM];
+pub const HERMITE_PARAMS: &[ParamSpec] = &JUMP_PARAMS;
 
 /// Fair Hermite data `(t, points, tangents)` by `rule` (spec §2.6 without re-interpolation):
 /// the bad point is the interior point with the largest `|J_k|` of the C¹ Hermite curve, it

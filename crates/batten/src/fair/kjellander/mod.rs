@@ -114,14 +114,14 @@ use super::{FairMethod, FairOptions, Outcome, ParamSpec};
 use crate::error::Result;
 use crate::geom::PointSeq;
 
-use super::engine::{EPSILON_PARAM, THRESHOLD_PARAM};
+use super::engine::{EPSILON, JUMP_PARAMS};
 // The engine's constants, at the paths they had when the engine lived here.
 pub use super::engine::{
     DEFAULT_MOVES_PER_POINT, DEFAULT_THRESHOLD, JUMP_ZERO_REL, MIN_CHORD_REL, MIN_STEP_FRACTION,
     RETRY_CHANGE_REL, TOLERANCE_MARGIN,
 };
 pub use hermite::{HERMITE_PARAMS, fair_hermite};
-use params::{MODE_PARAM, REPARAMETRIZE_PARAM, energy_rule, point_params};
+use params::{ENERGY_PARAMS, POLIAKOFF_PARAMS, energy_rule, point_params};
 pub use points::SOLVE_HALF_WIDTH;
 use points::run_points;
 pub use rules::{
@@ -146,11 +146,11 @@ pub struct Energy;
 
 /// Parameters in data units of `kjellander` and their power of length: the jumps of the
 /// uniform spline's third derivative are lengths.
-const UNIFORM_LENGTH_PARAMS: &[(&str, i32)] = &[("epsilon", 1), ("initial_max_jump", 1)];
+const UNIFORM_LENGTH_PARAMS: &[(&str, i32)] = &[(EPSILON.name, 1), ("initial_max_jump", 1)];
 
 /// Parameters in data units of `poliakoff` and `energy`: on the chord-length spline the
 /// third derivative has the unit 1/length².
-const CHORD_LENGTH_PARAMS: &[(&str, i32)] = &[("epsilon", -2), ("initial_max_jump", -2)];
+const CHORD_LENGTH_PARAMS: &[(&str, i32)] = &[(EPSILON.name, -2), ("initial_max_jump", -2)];
 
 impl FairMethod for Kjellander {
     fn name(&self) -> &'static str {
@@ -162,7 +162,7 @@ impl FairMethod for Kjellander {
     }
 
     fn parameters(&self) -> &'static [ParamSpec] {
-        &[THRESHOLD_PARAM, EPSILON_PARAM]
+        &JUMP_PARAMS
     }
 
     fn supports_closed(&self) -> bool {
@@ -204,7 +204,7 @@ impl FairMethod for Poliakoff {
     }
 
     fn parameters(&self) -> &'static [ParamSpec] {
-        &[THRESHOLD_PARAM, EPSILON_PARAM, REPARAMETRIZE_PARAM]
+        &POLIAKOFF_PARAMS
     }
 
     fn supports_closed(&self) -> bool {
@@ -246,12 +246,7 @@ impl FairMethod for Energy {
     }
 
     fn parameters(&self) -> &'static [ParamSpec] {
-        &[
-            THRESHOLD_PARAM,
-            EPSILON_PARAM,
-            REPARAMETRIZE_PARAM,
-            MODE_PARAM,
-        ]
+        &ENERGY_PARAMS
     }
 
     fn supports_closed(&self) -> bool {

@@ -5,7 +5,7 @@
 
 use serde_json::json;
 
-use super::params::point_params;
+use super::params::{MODE, REPARAMETRIZE, point_params};
 use super::rules::{KpRule, Local};
 use crate::error::{Error, Result};
 use crate::fair::engine::{
@@ -307,7 +307,7 @@ pub(super) fn run_points(
         json!(if closed { "periodic" } else { "natural" }),
     );
     if !uniform {
-        parameters.insert("reparametrize".into(), json!(reparametrize));
+        REPARAMETRIZE.write(&mut parameters, reparametrize);
     }
     if matches!(rule, KpRule::Energy | KpRule::EnergyPositionOnly) {
         let mode = if rule == KpRule::Energy {
@@ -315,7 +315,7 @@ pub(super) fn run_points(
         } else {
             "position"
         };
-        parameters.insert("mode".into(), json!(mode));
+        MODE.write(&mut parameters, mode);
     }
     parameters.insert("solve_half_width".into(), json!(SOLVE_HALF_WIDTH));
     Ok(Outcome {

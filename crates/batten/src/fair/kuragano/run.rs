@@ -5,10 +5,11 @@
 use serde_json::{Map, Value, json};
 
 use super::Kuragano;
+use super::params::{DEGREE, ENDS, GRADIENT_FRACTION, RESIDUAL, RHO_MAX, SAMPLES};
 use crate::analysis::roc_fairness::{
-    Design, DesignEnds, Evaluation, KuraganoOptions, MIN_DEGREE, Modification, RhoFit, RhoSamples,
-    ShapeConstraints, StopReason, design_curve, design_samples, evaluate_detailed, fits,
-    modify_shape,
+    Design, DesignEnds, Evaluation, KuraganoOptions, MIN_DEGREE, Modification, Residual, RhoFit,
+    RhoSamples, ShapeConstraints, StopReason, design_curve, design_samples, evaluate_detailed,
+    fits, modify_shape,
 };
 use crate::curve::Curve;
 use crate::error::{Error, Result};
@@ -49,7 +50,7 @@ pub(super) fn run_points(input: &PointSeq, options: &FairOptions) -> Result<Outc
             ..Outcome::default()
         });
     };
-    parameters.insert("degree".into(), json!(chosen));
+    DEGREE.write(&mut parameters, Some(chosen));
     let constrained = options.tolerance.is_some() || options.fix_ends.is_fixed();
     let reuse = reusable
         .get_mut(chosen - MIN_DEGREE)
@@ -100,16 +101,20 @@ fn design_parameters(
     samples: &RhoSamples,
     evaluation: Option<&Evaluation>,
 ) {
-    parameters.insert("samples".into(), json!(samples.s.len()));
-    parameters.insert("rho_max".into(), json!(samples.rho_max));
-    parameters.insert("residual".into(), json!(kopts.residual));
+    SAMPLES.write(parameters, Some(samples.s.len()));
+    RHO_MAX.write(parameters, Some(samples.rho_max));
+    let residual = match kopts.residual {
+        Residual::Rho => "rho",
+        Residual::Kappa => "kappa",
+    };
+    RESIDUAL.write(parameters, residual);
     let ends = match kopts.ends {
         DesignEnds::Natural => "natural",
         DesignEnds::Gradients { .. } => "gradients",
     };
-    parameters.insert("ends".into(), json!(ends));
+    ENDS.write(parameters, ends);
     if let DesignEnds::Gradients { fraction } = kopts.ends {
-        parameters.insert("gradient_fraction".into(), json!(fraction));
+        GRADIENT_FRACTION.write(parameters, fraction);
     }
     parameters.insert("arc_length".into(), json!(samples.length));
     if let Some(e) = evaluation {

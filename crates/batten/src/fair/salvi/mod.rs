@@ -93,8 +93,6 @@ mod curve;
 mod params;
 mod target;
 
-use serde_json::Value;
-
 use super::local::{self, json_f64};
 use super::{FairMethod, FairOptions, Outcome, ParamSpec};
 use crate::error::Result;
@@ -105,7 +103,7 @@ pub use curve::{
     SIMPLEX_MAX_EVALUATIONS, SIMPLEX_STEP_REL, STALL_REL_IMPROVEMENT, SalviReport, fair_curve,
 };
 pub use params::{DEFAULT_MAX_ITERATIONS, DEFAULT_WINDOW, SalviParams, WINDOW_MIN_REL_IMPROVEMENT};
-use params::{PARAMS, salvi_params};
+use params::{PARAMS, report_params, salvi_params};
 pub use target::{
     DEFAULT_PASSES, DEFAULT_SAMPLES, HALF_WIDTH_DIVISOR, LOOSE_SAMPLES_PER_COEFFICIENT,
     MAX_SAMPLES, MIN_SAMPLES, MIN_TARGET_COEFFICIENTS, SAMPLES_PER_SPAN, Smoother, moving_average,
@@ -173,17 +171,7 @@ fn run_fitted(
     let (faired, report) = fair_curve(&fitted.curve, &params)?;
     let points = local::output_points(&faired, &fitted, input, options.fix_ends.is_fixed());
     let mut parameters = fitted.parameters.clone();
-    parameters.insert("samples".into(), report.samples.len().into());
-    parameters.insert(
-        "smoother".into(),
-        Value::from(match params.smoother {
-            Smoother::BSplineFit { .. } => "bspline",
-            _ => "average",
-        }),
-    );
-    parameters.insert("pin_ends".into(), params.pin_ends.into());
-    parameters.insert("tabu".into(), params.tabu_length.into());
-    parameters.insert("window".into(), params.window.into());
+    report_params(&mut parameters, &params, report.samples.len());
     parameters.insert("max_iterations".into(), params.max_iterations.into());
     local::insert_common(&mut parameters, &report.local);
     parameters.insert(

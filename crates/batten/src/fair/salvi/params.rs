@@ -2,8 +2,11 @@
 //! parsing (`docs/algorithms/salvi-varady.md`, "Parameters").
 
 use super::target::{DEFAULT_PASSES, MAX_SAMPLES, MIN_SAMPLES, MIN_TARGET_COEFFICIENTS, Smoother};
+use serde_json::{Map, Value};
+
 use crate::error::Result;
-use crate::fair::local::{DEFAULT_TABU_LENGTH, FIT_PARAMS};
+use crate::fair::local::{CONTROL_POINTS, DEFAULT_TABU_LENGTH, FIT_DEGREE, FREE_ENDS, TABU};
+use crate::fair::params::{Auto, Choice, Flag, Number, Param};
 use crate::fair::{FairOptions, ParamSpec};
 
 /// Default iteration limit (the paper's Table 1 runs 1000 iterations).
@@ -159,50 +162,89 @@ impl Default for SalviParams {
     }
 }
 
-pub(super) static PARAMS: [ParamSpec; 11] = [
-    ParamSpec {
-        name: "samples",
-        default: "auto",
-        doc: "number of curvature samples N, 4..=20000 (auto: max(200, 8 per knot span))",
+/// N (`auto`: [`super::sample_count`]).
+const SAMPLES: Param<Auto<usize>> = Param {
+    name: "samples",
+    kind: Auto {
+        min: MIN_SAMPLES,
+        max: MAX_SAMPLES,
     },
-    ParamSpec {
-        name: "smoother",
+    doc: "number of curvature samples N, 4..=20000 (auto: max(200, 8 per knot span))",
+};
+
+/// How the target curvature is made ([`Smoother`]).
+const SMOOTHER: Param<Choice> = Param {
+    name: "smoother",
+    kind: Choice {
         default: "average",
-        doc: "target curvature: average (moving average) or bspline (least-squares fit of κ(s))",
+        choices: &["average", "bspline"],
     },
-    ParamSpec {
-        name: "half_width",
-        default: "auto",
-        doc: "moving-average half-width in samples (auto: N/20; at most 20000)",
+    doc: "target curvature: average (moving average) or bspline (least-squares fit of κ(s))",
+};
+
+/// The moving average's half-width (`auto`: N / [`super::HALF_WIDTH_DIVISOR`]).
+const HALF_WIDTH: Param<Auto<usize>> = Param {
+    name: "half_width",
+    kind: Auto {
+        min: 0,
+        max: MAX_SAMPLES,
     },
-    ParamSpec {
-        name: "passes",
-        default: "3",
-        doc: "moving-average passes",
+    doc: "moving-average half-width in samples (auto: N/20; at most 20000)",
+};
+
+/// The moving average's passes ([`DEFAULT_PASSES`]).
+const PASSES: Param<Number<usize>> = Param {
+    name: "passes",
+    kind: Number {
+        default: DEFAULT_PASSES,
+        min: 0,
+        max: 1000,
     },
-    ParamSpec {
-        name: "target_coefficients",
-        default: "auto",
-        doc: "coefficients of the bspline target fit (auto: max(4, N/20); at most 20000)",
+    doc: "moving-average passes",
+};
+
+/// The coefficients of the least-squares target (`auto`: from N).
+const TARGET_COEFFICIENTS: Param<Auto<usize>> = Param {
+    name: "target_coefficients",
+    kind: Auto {
+        min: MIN_TARGET_COEFFICIENTS,
+        max: MAX_SAMPLES,
     },
-    ParamSpec {
-        name: "pin_ends",
-        default: "false",
-        doc: "make the target equal the curvature at both ends",
+    doc: "coefficients of the bspline target fit (auto: max(4, N/20); at most 20000)",
+};
+
+/// [`SalviParams::pin_ends`].
+const PIN_ENDS: Param<Flag> = Param {
+    name: "pin_ends",
+    kind: Flag {
+        default: SalviParams::DEFAULT.pin_ends,
     },
-    ParamSpec {
-        name: "tabu",
-        default: "4",
-        doc: "length R of the recently-moved list",
+    doc: "make the target equal the curvature at both ends",
+};
+
+/// [`SalviParams::window`].
+const WINDOW: Param<Number<usize>> = Param {
+    name: "window",
+    kind: Number {
+        default: DEFAULT_WINDOW,
+        min: 0,
+        max: crate::fair::MAX_ITERATIONS,
     },
-    ParamSpec {
-        name: "window",
-        default: "50",
-        doc: "stop when the measure improved < 0.1% over this many iterations (0: never; at most 1000000)",
-    },
-    FIT_PARAMS[0],
-    FIT_PARAMS[1],
-    FIT_PARAMS[2],
+    doc: "stop when the measure improved < 0.1% over this many iterations (0: never; at most 1000000)",
+};
+
+pub(super) static PARAMS: [ParamSpec; 11] = [
+    SAMPLES.spec(),
+    SMOOTHER.spec(),
+    HALF_WIDTH.spec(),
+    PASSES.spec(),
+    TARGET_COEFFICIENTS.spec(),
+    PIN_ENDS.spec(),
+    TABU.spec(),
+    WINDOW.spec(),
+    FIT_DEGREE.spec(),
+    CONTROL_POINTS.spec(),
+    FREE_ENDS.spec(),
 ];
 
 /// The parameters of a run; `tolerance` (δ) and `free_ends` come from the fitted input. The
@@ -212,12 +254,11 @@ pub(super) fn salvi_params(
     tolerance: Option<f64>,
     free_ends: bool,
 ) -> Result<SalviParams> {
-    let samples = options.param_auto_usize_in("samples", MIN_SAMPLES, MAX_SAMPLES)?;
-    let auto_usize = |key: &str, lo: usize| options.param_auto_usize_in(key, lo, MAX_SAMPLES);
-    let coefficients = auto_usize("target_coefficients", MIN_TARGET_COEFFICIENTS)?;
-    let half_width = auto_usize("half_width", 0)?;
-    let passes = options.param_usize_in("passes", DEFAULT_PASSES, 0, 1000)?;
-    let smoother = match options.param_choice("smoother", "average", &["average", "bspline"])? {
+    let samples = options.get(&SAMPLES)?;
+    let coefficients = options.get(&TARGET_COEFFICIENTS)?;
+    let half_width = options.get(&HALF_WIDTH)?;
+    let passes = options.get(&PASSES)?;
+    let smoother = match options.get(&SMOOTHER)? {
         "bspline" => Smoother::BSplineFit { coefficients },
         _ => Smoother::MovingAverage { half_width, passes },
     };
@@ -225,14 +266,32 @@ pub(super) fn salvi_params(
     Ok(SalviParams {
         samples,
         smoother,
-        pin_ends: options.param_bool("pin_ends", false)?,
+        pin_ends: options.get(&PIN_ENDS)?,
         tolerance,
-        tabu_length: options.param_usize_in("tabu", DEFAULT_TABU_LENGTH, 0, 1000)?,
+        tabu_length: options.get(&TABU)?,
         max_iterations,
-        window: options.param_usize_in("window", DEFAULT_WINDOW, 0, crate::fair::MAX_ITERATIONS)?,
+        window: options.get(&WINDOW)?,
         min_rel_improvement: WINDOW_MIN_REL_IMPROVEMENT,
         free_ends,
         held_ends: options.fix_ends.held().max(1),
         skip_stalled: true,
     })
+}
+
+/// The parameters of a run as used, for the report: N as sampled, the smoother, and the
+/// values read from the options.
+pub(super) fn report_params(
+    parameters: &mut Map<String, Value>,
+    params: &SalviParams,
+    samples: usize,
+) {
+    SAMPLES.write(parameters, Some(samples));
+    let smoother = match params.smoother {
+        Smoother::BSplineFit { .. } => "bspline",
+        _ => "average",
+    };
+    SMOOTHER.write(parameters, smoother);
+    PIN_ENDS.write(parameters, params.pin_ends);
+    TABU.write(parameters, params.tabu_length);
+    WINDOW.write(parameters, params.window);
 }
