@@ -106,6 +106,8 @@ mod layout;
 mod modify;
 mod options;
 mod samples;
+#[cfg(test)]
+mod tests;
 
 pub use evaluate::{
     DegreeResult, Design, Evaluation, PAPER_TIE_TOLERANCE, TIE_TOLERANCE, angle_degrees, cosine,

@@ -124,6 +124,8 @@ mod pipeline;
 mod responses;
 mod segment;
 mod sign;
+#[cfg(test)]
+mod tests;
 
 use super::{EndFix, FairMethod, FairStatus, Outcome, ParamSpec, clamp_to_tolerance};
 use crate::error::Result;

@@ -92,6 +92,8 @@
 mod curve;
 mod params;
 mod target;
+#[cfg(test)]
+mod tests;
 
 use super::local::{self, json_f64};
 use super::{FairMethod, FairOptions, Outcome, ParamSpec};

@@ -1,19 +1,20 @@
 //! Tests of the `han` method (spec §1): every `han.*` test vector, the properties of the unit
 //! responses, each fairing case on a constructed example, the curve pipeline (partition,
 //! strophoid, closed curves) and property tests (tolerance, fixed ends, rigid motions).
+//!
+//! Unit tests (formerly `tests/han.rs`): they reach the paper's case procedures, the unit
+//! responses and the partition, which are not public.
 
 #![allow(clippy::unwrap_used, clippy::needless_range_loop)]
 
 use std::collections::BTreeMap;
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use batten::analysis::{FairnessMetrics, ZERO_REL};
-use batten::fair::han::{
-    self, CaseMove, MoveTag, Procedure, Segment, SegmentParams, UnitResponses,
-};
-use batten::fair::{self, FairOptions, FairStatus};
-use batten::spline::{CubicSplineFn, FnEndCondition};
-use batten::{Error, Point, PointSeq, Rigid, Vec2};
+use crate::analysis::{FairnessMetrics, ZERO_REL};
+use crate::fair::han::{self, CaseMove, MoveTag, Procedure, Segment, SegmentParams, UnitResponses};
+use crate::fair::{self, FairOptions, FairStatus};
+use crate::spline::{CubicSplineFn, FnEndCondition};
+use crate::{Error, Point, PointSeq, Rigid, Vec2};
 use proptest::prelude::*;
 use serde_json::Value;
 
@@ -443,7 +444,7 @@ fn sign_runs(c: &[f64]) -> Vec<(usize, usize, i8)> {
     let scale = c.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     let mut runs: Vec<(usize, usize, i8)> = Vec::new();
     for (i, v) in c.iter().enumerate() {
-        let s = batten::analysis::sgn0(*v, scale);
+        let s = crate::analysis::sgn0(*v, scale);
         match runs.last_mut() {
             Some(r) if r.2 == s => r.1 += 1,
             _ => runs.push((i, 1, s)),
@@ -1574,7 +1575,7 @@ proptest! {
             let method = SegmentParams::DEFAULT.with_fine_run3(han::DEFAULT_FINE_RUN3);
             // With the floors `fair` uses: those of each input's coordinate magnitude.
             let seg = |x, y, pts: &[Point]| {
-                let coord = batten::geom::max_abs_coordinate(pts);
+                let coord = crate::geom::max_abs_coordinate(pts);
                 Segment::new(x, y)
                     .and_then(|s| s.with_params(method))
                     .map(|s| s.with_coordinate_scale(coord))

@@ -1,22 +1,44 @@
 //! Salvi & Várady target-curvature fairing and Eck & Hadenfeld local energy fairing
 //! (spec §3): the `salvi_varady` test vectors, the properties of `sv.fair.properties`, and
 //! the behaviour of both methods on B-spline and point input.
+//!
+//! Unit tests (formerly `tests/salvi.rs`): they reach the target curvature and the shared
+//! local-fairing machinery of `fair/local.rs`, which are not public.
 
-use batten::fair::eck_hadenfeld::{self, EckHadenfeldParams};
-use batten::fair::local::{
+use crate::fair::eck_hadenfeld::{self, EckHadenfeldParams};
+use crate::fair::local::{
     RecentList, clamp_to_original, principal_curvatures, support_ranges, uniform_samples,
 };
-use batten::fair::salvi::{self, SalviParams, Smoother};
-use batten::fair::{self, FairStatus};
-use batten::spline::{BSplineCurve, KnotVector};
-use batten::{Curve, Error, FairOptions, Point, PointSeq};
+use crate::fair::salvi::{self, SalviParams, Smoother};
+use crate::fair::{self, FairStatus};
+use crate::spline::{BSplineCurve, KnotVector};
+use crate::{Curve, Error, FairOptions, Point, PointSeq};
 use proptest::prelude::*;
 use serde_json::Value;
 
-mod common;
-use common::Rng;
+const VECTORS: &str = include_str!("../../../tests/data/test-vectors.json");
 
-const VECTORS: &str = include_str!("data/test-vectors.json");
+/// The seeded xorshift of `tests/common` (shifts 13, 7, 17), for the same noise.
+struct Rng(u64);
+
+impl Rng {
+    fn new(seed: u64) -> Rng {
+        Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+    }
+
+    fn uniform(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// A standard normal sample: Box–Muller on two uniform samples.
+    fn gaussian(&mut self) -> f64 {
+        let (a, b) = (self.uniform(), self.uniform());
+        (-2.0 * a.max(1e-300).ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+    }
+}
 
 fn vector(id: &str) -> Value {
     let all: Value = serde_json::from_str(VECTORS).expect("test-vectors.json parses");
@@ -133,7 +155,7 @@ fn rms_difference(a: &[f64], b: &[f64]) -> f64 {
     (a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>() / a.len() as f64).sqrt()
 }
 
-fn non_increasing(history: &[batten::fair::HistoryRow]) -> bool {
+fn non_increasing(history: &[crate::fair::HistoryRow]) -> bool {
     history.windows(2).all(|w| w[1].measure <= w[0].measure)
 }
 
@@ -259,7 +281,7 @@ fn vector_principal_curvatures_paraboloid() {
         )
         .expect("basis curve");
         let span = c.find_span(t);
-        let mut b = [[0.0; batten::spline::MAX_ORDER]; 4];
+        let mut b = [[0.0; crate::spline::MAX_ORDER]; 4];
         c.basis_derivs(span, t, 2, &mut b);
         (span - 3, b)
     };
@@ -656,7 +678,7 @@ fn degenerate_and_invalid_input() {
 
 #[test]
 fn recent_list_capacity_four_by_default() {
-    assert_eq!(batten::fair::local::DEFAULT_TABU_LENGTH, 4);
+    assert_eq!(crate::fair::local::DEFAULT_TABU_LENGTH, 4);
     let mut l = RecentList::new(SalviParams::DEFAULT.tabu_length);
     for j in 0..6 {
         l.push(j);
