@@ -10,7 +10,8 @@ mod curvature;
 mod gfi;
 mod metrics;
 mod noise;
-pub mod roc_fairness;
+// `fair::kuragano` runs the same specification and shape modification.
+pub(crate) mod roc_fairness;
 mod space;
 mod space_curve;
 
@@ -25,5 +26,11 @@ pub use metrics::{
 };
 pub(crate) use noise::is_planar;
 pub use noise::{MAD_TO_SIGMA, MEDIAN_LENGTH_2D_TO_SIGMA, noise_sigma, noise_sigma_space};
+pub use roc_fairness::{
+    DEFAULT_METHOD_GRADIENT_FRACTION, DegreeResult, Design as RocDesign, DesignEnds,
+    Evaluation as RocEvaluation, KuraganoOptions, MAX_SAMPLES as ROC_MAX_SAMPLES,
+    Residual as RhoResidual, TIE_TOLERANCE as ROC_TIE_TOLERANCE, angle_degrees,
+    evaluate as evaluate_roc_fairness, truncate_angle,
+};
 pub use space::SpaceMetrics;
 pub use space_curve::{SpaceCubic, SpaceDerivatives, SpaceSample};

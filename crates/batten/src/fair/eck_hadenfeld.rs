@@ -318,11 +318,6 @@ impl Gram {
         (lo..hi).map(move |i| if cyclic { i % n } else { i })
     }
 
-    /// Half-bandwidth p.
-    pub fn bandwidth(&self) -> usize {
-        self.p
-    }
-
     /// `Σ_{i≠j} G_ji d_i`, the coupling of control point j to the others.
     pub fn coupling(&self, d: &[Point], j: usize) -> Vec2 {
         let mut s = Vec2::ZERO;
@@ -411,6 +406,7 @@ fn rational_derivative(b: &[[f64; MAX_ORDER]; 4], w: &[f64], o: usize, out: &mut
 ///
 /// # Errors
 /// As [`Gram::new`].
+#[cfg(test)]
 pub fn energy(curve: &BSplineCurve, order: usize) -> Result<f64> {
     Ok(Gram::new(curve, order)?.energy(curve.control_points()))
 }

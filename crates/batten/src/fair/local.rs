@@ -190,22 +190,14 @@ impl RecentList {
         self.items.clear();
     }
 
-    /// Number of entries.
-    pub fn len(&self) -> usize {
-        self.items.len()
-    }
-
     /// Whether the list is empty.
+    #[cfg(test)]
     pub fn is_empty(&self) -> bool {
         self.items.is_empty()
     }
 
-    /// The capacity R.
-    pub fn capacity(&self) -> usize {
-        self.capacity
-    }
-
     /// The entries, oldest first.
+    #[cfg(test)]
     pub fn iter(&self) -> impl Iterator<Item = usize> + '_ {
         self.items.iter().copied()
     }

@@ -11,25 +11,26 @@
 //! of its parameters once as a `Param` constant (`params.rs`: key, kind with default and
 //! range, doc) and list it in [`methods`].
 
-pub mod band;
-pub mod cali;
+mod band;
+mod cali;
 mod catalogue;
 mod clean;
 mod compare;
-pub mod eck_hadenfeld;
+mod eck_hadenfeld;
 mod engine;
 mod guard;
-pub mod han;
-pub mod kjellander;
-pub mod kuragano;
-pub mod local;
+mod han;
+mod kjellander;
+mod kuragano;
+// The local-move helpers the surface methods share with `salvi` and `eck-hadenfeld`.
+pub(crate) mod local;
 mod options;
 mod params;
 mod periodic;
 mod report;
-pub mod salvi;
-pub mod sapidis_farin;
-pub mod smoothing;
+mod salvi;
+mod sapidis_farin;
+mod smoothing;
 mod smoothing_mst;
 mod smoothing_system;
 mod smoothing_trial;
@@ -38,24 +39,35 @@ mod space;
 use std::time::Instant;
 
 pub use band::{Band, auto_k as band_tolerance_factor};
-pub use cali::Cali;
+pub use cali::{Cali, LocalIndicators, Trial as IndicatorTrial};
 pub use catalogue::{MethodInfo, ParamInfo, catalogue};
 pub use clean::LOCAL_CHECK_HALF_WIDTH;
 pub use compare::{Comparison, ComparisonOutcome, ComparisonRow, compare};
-pub use eck_hadenfeld::EckHadenfeld;
+pub use eck_hadenfeld::{EckHadenfeld, EckHadenfeldParams, fair_curve as eck_hadenfeld_fair_curve};
 pub use guard::{CLEAN_SLACK_REL, METHOD_SCALE_RANGE_LOG2};
-pub use han::Han;
-pub use kjellander::{
-    Energy, HermiteMove, Kjellander, KpRule, Poliakoff, fair_hermite, hermite_step,
+pub use han::{
+    CaseMove as HanCaseMove, Han, MoveTag as HanMoveTag, Segment as HanSegment,
+    SegmentParams as HanSegmentParams,
 };
+pub use kjellander::{
+    Energy, HermiteMove, Kjellander, KpRule, Poliakoff, energy_change_f, fair_hermite,
+    hermite_step, parametric_energy,
+};
+pub use kuragano::Kuragano;
+pub use local::LocalReport;
 pub use options::{AUTO_TOLERANCE_K, EndFix, FairOptions, MAX_ITERATIONS};
 pub use params::{ParamDefault, ParamSpec, ParamType};
 pub use report::{
     EndChanges, FairReport, FairStatus, HistoryRow, Move, SolverInfo, ToleranceSource,
 };
-pub use salvi::Salvi;
+pub use salvi::{
+    MAX_SAMPLES as SALVI_MAX_SAMPLES, Salvi, SalviParams, SalviReport, Smoother as SalviSmoother,
+    fair_curve as salvi_fair_curve,
+};
 pub use sapidis_farin::{SapidisFarin, remove_reinsert_knot};
-pub use smoothing::{Mst, Smoothing, SmoothingInfo, SmoothingSpline, SmoothingTrial};
+pub use smoothing::{
+    BISECTION_REL_PRECISION, Mst, Smoothing, SmoothingInfo, SmoothingSpline, SmoothingTrial,
+};
 pub use space::{
     FairedSpace, SPACE_METHODS, SpaceFairReport, SpaceOutcome, check_space_method, fair_space,
 };

@@ -96,7 +96,6 @@ use super::engine::{
     JUMP_PARAMS, JUMP_ZERO_REL, LocalProblem, MIN_CHORD_REL, MaxTree, Threshold, drive,
     driven_parameters, max_fraction, move_limit, tolerance_radius,
 };
-pub use super::periodic::MIN_CLOSED_POINTS;
 use super::periodic::{PAD, interpolate_closed, period_index};
 use super::{FairMethod, FairOptions, Outcome, ParamSpec};
 use crate::curve::Curve;

@@ -64,7 +64,7 @@
 //! behave the same at every scale.
 
 use super::FairOptions;
-pub use super::smoothing_mst::{Mst, p_at_scale};
+pub use super::smoothing_mst::Mst;
 use super::smoothing_system::Penta;
 pub(crate) use super::smoothing_trial::roughness;
 use super::smoothing_trial::{dot, max_displacement};

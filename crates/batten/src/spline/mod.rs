@@ -14,7 +14,8 @@ mod interpolate;
 mod knots;
 mod lambda_operator;
 mod parametric;
-pub mod quintic;
+// The radius-of-curvature analysis samples the quintic in closed form.
+pub(crate) mod quintic;
 
 pub(crate) use bspline::basis_derivs;
 pub use bspline::{BSplineCurve, MAX_ORDER};
@@ -27,4 +28,9 @@ pub use parametric::{EndCondition, ParametricCubic, Parametrization, parameters}
 pub(crate) use parametric::{
     Ends, c2_closed_tangents, c2_tangents, hermite_coeffs, open_tangents, periodic_tangents,
     span_derivatives,
+};
+pub use quintic::{
+    DEFAULT_GRADIENT_FRACTION as QUINTIC_GRADIENT_FRACTION, Ends as QuinticEnds,
+    HermiteSystem as QuinticHermiteSystem, QuinticForm, end_gradients as quintic_end_gradients,
+    interpolate as interpolate_quintic, interpolate_hermite as interpolate_quintic_hermite,
 };

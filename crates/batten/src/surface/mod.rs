@@ -16,12 +16,12 @@
 //!   stripes and the deviation between two surfaces — rasterised from a [`SurfaceMesh`] in an
 //!   orthographic [`Camera`] view into an RGBA [`Raster`].
 
-pub mod eck_hadenfeld;
+mod eck_hadenfeld;
 mod fairing;
 mod fit;
 mod patch;
 mod render;
-pub mod salvi;
+mod salvi;
 mod sample;
 mod target;
 

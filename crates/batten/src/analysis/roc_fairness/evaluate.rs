@@ -31,6 +31,7 @@ pub const TIE_TOLERANCE: f64 = 1e-4;
 
 /// The tie tolerance that reproduces every choice of the paper's Table 4 (curve B
 /// included): two cosines near 1.5° that print as angles 0.02° apart differ by about 10⁻⁵.
+#[cfg(test)]
 pub const PAPER_TIE_TOLERANCE: f64 = 1e-6;
 
 /// The cosine of two sample vectors, not mean-centred (spec §5.6 step 2); `None` when either

@@ -76,6 +76,7 @@ impl RhoFit {
     }
 
     /// The coefficients `c_0..c_d` of `ρ̂(s) = Σ c_e s^e` (monomial basis in s).
+    #[cfg(test)]
     pub fn coefficients_ascending(&self) -> Vec<f64> {
         // T_k(2s − 1) as polynomials in s, by the recurrence T_{k+1} = 2x T_k − T_{k−1}.
         let d = self.degree;

@@ -9,7 +9,7 @@ use super::options::Residual;
 use super::samples::{Evaluator, RhoSamples, check_polynomial, sample_at_fractions};
 use crate::curve::Curve;
 use crate::error::{Error, Result};
-use crate::geom::{Point, Vec2};
+use crate::geom::Point;
 use crate::numeric::SymBanded;
 use crate::spline::{BSplineCurve, MAX_ORDER};
 
@@ -44,7 +44,8 @@ pub const DIAG_FLOOR_REL: f64 = 1e-12;
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for a rational curve with unequal weights.
-pub fn rho_gradient(curve: &BSplineCurve, u: f64) -> Result<(f64, usize, Vec<Vec2>)> {
+#[cfg(test)]
+pub fn rho_gradient(curve: &BSplineCurve, u: f64) -> Result<(f64, usize, Vec<crate::geom::Vec2>)> {
     check_polynomial(curve)?;
     let local = Evaluator::new(curve).local(u);
     let rho = 1.0 / local.kappa;

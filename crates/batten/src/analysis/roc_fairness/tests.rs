@@ -8,6 +8,9 @@
 
 use serde_json::Value;
 
+use super::evaluate::{PAPER_TIE_TOLERANCE, cosine, select_best_within};
+use super::modify::rho_gradient;
+use super::samples::sample_rho;
 use super::*;
 use crate::curve::{Curve, CurveDeriv};
 use crate::fair::{self, FairOptions};

@@ -73,7 +73,6 @@ use debias::{ENERGY_CAP, Penalized};
 use energy::{Energy, Metric};
 use form::Form;
 use params::{BandParams, PARAMS};
-pub use params::{DEFAULT_EPS, DEFAULT_MAX_ITERATIONS, DEFAULT_PASSES};
 use solver::{Problem, solve};
 
 /// A point counts as on the band's edge when its displacement is within this fraction of the

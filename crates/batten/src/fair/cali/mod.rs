@@ -113,7 +113,7 @@ use crate::error::{Error, Result};
 use crate::geom::PointSeq;
 use crate::spline::MAX_ORDER;
 
-pub use indicators::{LocalIndicators, ROUNDING_FACTOR, Trial};
+pub use indicators::{LocalIndicators, Trial};
 use run::{Settings, run_cali};
 
 /// The relaxation factor τ of the acceptance test `GFI_new < τ·GFI` (paper §5, spec §4.5).

@@ -1,7 +1,7 @@
 //! `han`'s parameters: their defaults, the table `batten methods` shows, and the typed values
 //! of a run parsed from the options (`docs/algorithms/han.md`, "Parameters").
 
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::FRAC_PI_2;
 
 use serde_json::{Map, Value};
 
@@ -28,16 +28,12 @@ pub const DEFAULT_OVERLAP: usize = 5;
 pub const MAX_OVERLAP: usize = 1_000_000;
 /// Default number of pipeline passes (partition, fair, blend) \[CHOICE\].
 pub const DEFAULT_PASSES: usize = 3;
-/// The paper's turning threshold of the partition, π \[PAPER\] (`--set max_turn=pi`).
-pub const PAPER_MAX_TURN: f64 = PI;
 /// Default turning threshold of the partition, π/2 \[CHOICE\]: the value the spec recommends
 /// (§1.8 note). Segments then stay far from vertical local slopes, where the function-spline
 /// proxy breaks down; with the paper's π the end chords of a densely sampled segment are
 /// nearly vertical in its frame. Measured on the peer comparison (`bench/compare_peers.py`),
 /// π/2 (with fine case 3) is what makes `han` leave no more spurious inflections than csaps.
 pub const DEFAULT_MAX_TURN: f64 = FRAC_PI_2;
-/// The recommended turning threshold: the default, π/2.
-pub const RECOMMENDED_MAX_TURN: f64 = DEFAULT_MAX_TURN;
 /// Default iterations per segment, T \[CHOICE §1.7.3\].
 pub const DEFAULT_ITERATIONS: usize = 10;
 

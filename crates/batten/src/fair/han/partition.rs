@@ -19,18 +19,6 @@ pub struct Span {
     pub theta: f64,
 }
 
-impl Span {
-    /// Number of points.
-    pub fn len(&self) -> usize {
-        self.end + 1 - self.start
-    }
-
-    /// Always false: a span has at least two points.
-    pub fn is_empty(&self) -> bool {
-        self.end < self.start
-    }
-}
-
 /// Chord directions `φ_i = atan2(P_{i+1} − P_i)`, i = 0..N−2.
 ///
 /// # Errors
@@ -59,6 +47,7 @@ pub fn chord_angles(points: &[Point]) -> Result<Vec<f64>> {
 ///
 /// # Errors
 /// As [`chord_angles`].
+#[cfg(test)]
 pub fn turning_angles(points: &[Point]) -> Result<Vec<f64>> {
     let phi = chord_angles(points)?;
     Ok(unwrap_turning(&phi))

@@ -14,8 +14,6 @@ use crate::error::{Error, Result};
 use crate::geom::Point;
 use crate::spline::{CubicSplineFn, FnEndCondition};
 
-pub use cases::SINGULAR_REL;
-
 /// The fewest points a function segment must have to be faired (spec §1.7).
 pub const MIN_SEGMENT_POINTS: usize = 5;
 /// Rounding-noise floor of the sign tests \[CHOICE\]. Rounding the coordinates (magnitude R) to

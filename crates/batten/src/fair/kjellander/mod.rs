@@ -115,18 +115,10 @@ use crate::error::Result;
 use crate::geom::PointSeq;
 
 use super::engine::JUMP_PARAMS;
-// The engine's constants, at the paths they had when the engine lived here.
-pub use super::engine::{
-    DEFAULT_MOVES_PER_POINT, DEFAULT_THRESHOLD, JUMP_ZERO_REL, MIN_CHORD_REL, MIN_STEP_FRACTION,
-    RETRY_CHANGE_REL, TOLERANCE_MARGIN,
-};
-pub use hermite::{HERMITE_PARAMS, fair_hermite};
+pub use hermite::fair_hermite;
 use params::{ENERGY_PARAMS, POLIAKOFF_PARAMS, energy_rule, point_params};
-pub use points::SOLVE_HALF_WIDTH;
 use points::run_points;
-pub use rules::{
-    HermiteMove, KpRule, UNIT_STEP_REL, energy_change_f, hermite_step, parametric_energy,
-};
+pub use rules::{HermiteMove, KpRule, energy_change_f, hermite_step, parametric_energy};
 
 /// Method `kjellander`: uniform parametric cubic, the bad point moved by eq 4 (see the module
 /// docs).

@@ -76,6 +76,7 @@ impl Default for Smoother {
 ///
 /// # Errors
 /// [`Error::Degenerate`] at a parameter where the curvature is undefined (zero speed).
+#[cfg(test)]
 pub fn sample_curvature(curve: &BSplineCurve, t: &[f64]) -> Result<Vec<f64>> {
     t.iter()
         .map(|&ti| {
@@ -119,6 +120,7 @@ pub fn moving_average(values: &[f64], half_width: usize, passes: usize) -> Vec<f
 ///
 /// # Panics
 /// If the lengths differ.
+#[cfg(test)]
 pub fn target_measure(kappa: &[f64], target: &[f64]) -> f64 {
     assert_eq!(
         kappa.len(),

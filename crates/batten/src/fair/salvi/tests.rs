@@ -9,6 +9,9 @@ use crate::fair::eck_hadenfeld::{self, EckHadenfeldParams};
 use crate::fair::local::{
     RecentList, clamp_to_original, principal_curvatures, support_ranges, uniform_samples,
 };
+use crate::fair::salvi::target::{
+    moving_average, sample_curvature, target_curvature, target_measure,
+};
 use crate::fair::salvi::{self, SalviParams, Smoother};
 use crate::fair::{self, FairStatus};
 use crate::spline::{BSplineCurve, KnotVector};
@@ -173,7 +176,7 @@ fn vector_curvature_samples() {
         None,
     )
     .expect("curve");
-    let kappa = salvi::sample_curvature(&curve, &floats(&inp["t"])).expect("curvature");
+    let kappa = sample_curvature(&curve, &floats(&inp["t"])).expect("curvature");
     assert_close(
         &kappa,
         &floats(&v["expected"]["kappa"]),
@@ -188,18 +191,18 @@ fn vector_target_smoothing() {
     let kappa = floats(&v["inputs"]["kappa"]);
     let exp = &v["expected"];
     let tol = &v["tolerance"];
-    let g1 = salvi::moving_average(&kappa, 1, 1);
+    let g1 = moving_average(&kappa, 1, 1);
     assert_close(&g1, &floats(&exp["h1_passes1"]), tol, "h1_passes1");
-    let g2 = salvi::moving_average(&kappa, 2, 3);
+    let g2 = moving_average(&kappa, 2, 3);
     assert_close(&g2, &floats(&exp["h2_passes3"]), tol, "h2_passes3");
-    let m = salvi::target_measure(&kappa, &g1);
+    let m = target_measure(&kappa, &g1);
     // The stored measure has 12 significant digits.
     assert!((m - exp["measure_h1_passes1"].as_f64().expect("measure")).abs() < 1e-10);
     // The same smoother through the method's entry point (N = 10 gives h = ⌊10/20⌋ = 0, so the
     // half-width is given).
     let curve = sine_base();
     let t = uniform_samples(curve.domain(), kappa.len());
-    let g = salvi::target_curvature(
+    let g = target_curvature(
         &curve,
         &t,
         &kappa,
@@ -357,7 +360,7 @@ fn fair_properties() {
         assert!(local.max_control_displacement <= 0.2 * (1.0 + 1e-12));
         assert!(max_deviation(&faired, &noisy) <= 0.2 * (1.0 + 1e-12));
         assert!(r.max_curve_deviation <= 0.2 * (1.0 + 1e-12));
-        let truth = salvi::sample_curvature(&base, &r.samples).expect("curvature");
+        let truth = sample_curvature(&base, &r.samples).expect("curvature");
         let before = rms_difference(&r.curvature_before, &truth);
         let after = rms_difference(&r.curvature_after, &truth);
         assert!(
@@ -374,8 +377,8 @@ fn local_updates_agree_with_a_full_evaluation() {
     let noisy = perturbed(&sine_base(), 0.03, 11);
     let (faired, r) =
         salvi::fair_curve(&noisy, &SalviParams::DEFAULT.with_tolerance(0.2)).expect("fair");
-    let kappa = salvi::sample_curvature(&faired, &r.samples).expect("curvature");
-    let full = salvi::target_measure(&kappa, &r.target);
+    let kappa = sample_curvature(&faired, &r.samples).expect("curvature");
+    let full = target_measure(&kappa, &r.target);
     assert!((full - r.local.measure_after).abs() <= 1e-9 * full);
     let last = r.local.history.last().expect("history").measure;
     assert!((full - last).abs() <= 1e-9 * full);
@@ -455,8 +458,8 @@ fn knots_degree_and_weights_are_preserved() {
     assert!(non_increasing(&r.local.history) && r.local.measure_after < r.local.measure_before);
     assert!(non_increasing(&re.history) && re.measure_after < re.measure_before);
     // The rational bookkeeping agrees with a full evaluation too.
-    let k = salvi::sample_curvature(&s, &r.samples).expect("curvature");
-    let full = salvi::target_measure(&k, &r.target);
+    let k = sample_curvature(&s, &r.samples).expect("curvature");
+    let full = target_measure(&k, &r.target);
     assert!((full - r.local.measure_after).abs() <= 1e-9 * full);
 }
 
@@ -574,15 +577,15 @@ fn salvi_window_rule_and_stall_rule_stop_the_run() {
 fn targets_pinned_fitted_and_given() {
     let noisy = perturbed(&sine_base(), 0.03, 8);
     let t = uniform_samples(noisy.domain(), 200);
-    let kappa = salvi::sample_curvature(&noisy, &t).expect("curvature");
+    let kappa = sample_curvature(&noisy, &t).expect("curvature");
     for smoother in [
         Smoother::DEFAULT,
         Smoother::BSplineFit { coefficients: None },
     ] {
-        let g = salvi::target_curvature(&noisy, &t, &kappa, &smoother, true).expect("target");
+        let g = target_curvature(&noisy, &t, &kappa, &smoother, true).expect("target");
         assert_eq!(g[0], kappa[0]);
         assert_eq!(g[199], kappa[199]);
-        let free = salvi::target_curvature(&noisy, &t, &kappa, &smoother, false).expect("target");
+        let free = target_curvature(&noisy, &t, &kappa, &smoother, false).expect("target");
         // Away from the ends the pin changes nothing.
         assert_eq!(g[100], free[100]);
         // The target is smoother than the data: smaller second differences.
@@ -605,7 +608,7 @@ fn targets_pinned_fitted_and_given() {
     }
     // The true curvature as a given target ("manual editing") brings the curvature closer
     // to it than the moving average does.
-    let truth = salvi::sample_curvature(&sine_base(), &t).expect("curvature");
+    let truth = sample_curvature(&sine_base(), &t).expect("curvature");
     let params = SalviParams::DEFAULT.with_tolerance(0.2).with_samples(200);
     let (_, given) = salvi::fair_curve(
         &noisy,
