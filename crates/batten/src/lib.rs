@@ -32,6 +32,8 @@
 //! assert!(out.report.tolerance_met);
 //! ```
 
+#![warn(unreachable_pub)]
+
 pub mod analysis;
 pub mod curve;
 pub mod error;

@@ -80,7 +80,7 @@ pub const BISECTION_REL_PRECISION: f64 = 1e-3;
 /// Default limit on bisection steps in tolerance mode (`max_iterations` overrides it). The
 /// bracket is about 90 units of `ln α` wide at n = 10⁶, so ~17 steps reach
 /// [`BISECTION_REL_PRECISION`]; the default leaves ample room.
-pub const DEFAULT_MAX_BISECTION_STEPS: usize = 60;
+pub(super) const DEFAULT_MAX_BISECTION_STEPS: usize = 60;
 
 /// The searches start `LOG_ALPHA_BELOW` units of `ln α` below `ln α_ref`. The displacements
 /// `g − y = α W⁻¹ Q γ` vanish linearly with α, so at `α = α_ref·e⁻²⁵ ≈ 1.4·10⁻¹¹ α_ref` they

@@ -44,7 +44,7 @@ pub struct Mst;
 /// parameters) are multiplied by `f`: the objective `p·Σ|y − f|² + (1 − p)·∫|f''|² dt`
 /// becomes `p·f²·Σ + (1 − p)/f·∫`, so the ratio `(1 − p)/p` is divided by `f³`. Exact in
 /// real arithmetic; the limits p → 1 (interpolation) and p → 0 (the line) are kept.
-pub fn p_at_scale(p: f64, f: f64) -> f64 {
+pub(super) fn p_at_scale(p: f64, f: f64) -> f64 {
     if p <= 0.0 || p >= 1.0 {
         return p;
     }

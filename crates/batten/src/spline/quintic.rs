@@ -42,11 +42,11 @@ use crate::geom::{Point, Vec2};
 use crate::numeric::{PIVOT_REL, SymBanded};
 
 /// The degree of the KY curve: quintic (order 6).
-pub const DEGREE: usize = 5;
+pub(crate) const DEGREE: usize = 5;
 
 /// Width of the stencils: the derivatives of orders 0..4 at `t = 0` of a segment involve
 /// `q_i..q_{i+4}` only.
-pub const STENCIL_WIDTH: usize = 5;
+pub(crate) const STENCIL_WIDTH: usize = 5;
 
 /// `d^r R/dt^r` at `t = 0` of segment `i`, as coefficients of `q_i..q_{i+4}`, for r = 0..4
 /// (spec §5.1 table). Row 0 is eq 8, row 1 eq 9, rows 2 and 4 the end conditions.
@@ -55,7 +55,7 @@ pub const STENCIL_WIDTH: usize = 5;
 /// gives `N_1'''(0) = 6·20/120 = 1`, de Boor–Cox agrees, and only this row reproduces cubics
 /// (`q_j = j³` must give `R''' = 6`; the printed row gives 58). Row 3 is not used by any
 /// construction here.
-pub const ROWS: [[f64; STENCIL_WIDTH]; 5] = [
+pub(crate) const ROWS: [[f64; STENCIL_WIDTH]; 5] = [
     [
         1.0 / 120.0,
         26.0 / 120.0,
@@ -84,7 +84,7 @@ const BASIS_COEFFS: [[f64; 6]; 6] = [
 /// second derivatives (eq 4 and its derivative): `out[r][j] = d^r N_j/dt^r`, j = 0..5 for the
 /// control points `q_i..q_{i+5}` of segment i. Closed form, no allocation: the fast path of
 /// the KY shape modification.
-pub fn basis(t: f64) -> [[f64; 6]; 3] {
+pub(crate) fn basis(t: f64) -> [[f64; 6]; 3] {
     let mut out = [[0.0; 6]; 3];
     for (j, c) in BASIS_COEFFS.iter().enumerate() {
         let (mut v, mut d1, mut d2) = (0.0, 0.0, 0.0);
@@ -107,7 +107,7 @@ pub fn basis(t: f64) -> [[f64; 6]; 3] {
 /// Segment `i` in power form: `R(t) = Σ_e c_e t^e` (e = 0..5, local `t ∈ [0, 1]`) for its six
 /// control points `q_i..q_{i+5}` (eq 3 expanded). Derivatives follow by differentiating the
 /// polynomial, which is how the KY shape modification evaluates speed cheaply.
-pub fn power_form(q: [Point; 6]) -> [Vec2; 6] {
+pub(crate) fn power_form(q: [Point; 6]) -> [Vec2; 6] {
     let mut c = [Vec2::ZERO; 6];
     for (e, ce) in c.iter_mut().enumerate() {
         for (j, qj) in q.iter().enumerate() {
@@ -122,7 +122,7 @@ pub fn power_form(q: [Point; 6]) -> [Vec2; 6] {
 pub const DEFAULT_GRADIENT_FRACTION: f64 = 1.0 / 3.0;
 
 /// Fewest points an interpolant can have: two points give one segment (six control points).
-pub const MIN_POINTS: usize = 2;
+pub(crate) const MIN_POINTS: usize = 2;
 
 /// Largest width (in columns) a row may reach during the banded elimination. Every row ends
 /// at most five columns after its first one, and at column c every active row started at or
@@ -166,7 +166,7 @@ pub enum HermiteSystem {
 ///
 /// # Errors
 /// [`Error::TooFewPoints`] for fewer than six control points.
-pub fn uniform_knots(n_ctrl: usize) -> Result<KnotVector> {
+pub(crate) fn uniform_knots(n_ctrl: usize) -> Result<KnotVector> {
     if n_ctrl < DEGREE + 1 {
         return Err(Error::TooFewPoints {
             needed: DEGREE + 1,
@@ -184,7 +184,10 @@ pub fn uniform_knots(n_ctrl: usize) -> Result<KnotVector> {
 ///
 /// # Errors
 /// [`Error::TooFewPoints`] for fewer than six control points, [`Error::NonFinite`].
-pub fn from_control_points(control_points: Vec<Point>, form: QuinticForm) -> Result<BSplineCurve> {
+pub(crate) fn from_control_points(
+    control_points: Vec<Point>,
+    form: QuinticForm,
+) -> Result<BSplineCurve> {
     let n = control_points.len();
     let knots = uniform_knots(n)?;
     let weights = match form {
@@ -196,7 +199,7 @@ pub fn from_control_points(control_points: Vec<Point>, form: QuinticForm) -> Res
 
 /// True when `curve` is a quintic on uniform unit-spaced knots starting at −5 with all weights
 /// equal (absent or all one): the form this module builds.
-pub fn is_uniform_quintic(curve: &BSplineCurve) -> bool {
+pub(crate) fn is_uniform_quintic(curve: &BSplineCurve) -> bool {
     curve.degree() == DEGREE
         && curve
             .knots()

@@ -269,7 +269,7 @@ pub(crate) struct Common {
 /// overlaps those of `(2p + 1)(2q + 1) − 1` neighbours: the few points around the worst
 /// defect take turns for ever while their neighbours, which would have to move with them,
 /// never get chosen.
-pub fn tabu_length(degree: (usize, usize)) -> usize {
+pub(super) fn tabu_length(degree: (usize, usize)) -> usize {
     ((degree.0 + 1) * (degree.1 + 1)).max(DEFAULT_TABU_LENGTH)
 }
 

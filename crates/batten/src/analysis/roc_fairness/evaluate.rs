@@ -32,11 +32,11 @@ pub const TIE_TOLERANCE: f64 = 1e-4;
 /// The tie tolerance that reproduces every choice of the paper's Table 4 (curve B
 /// included): two cosines near 1.5° that print as angles 0.02° apart differ by about 10⁻⁵.
 #[cfg(test)]
-pub const PAPER_TIE_TOLERANCE: f64 = 1e-6;
+pub(super) const PAPER_TIE_TOLERANCE: f64 = 1e-6;
 
 /// The cosine of two sample vectors, not mean-centred (spec §5.6 step 2); `None` when either
 /// is zero.
-pub fn cosine(a: &[f64], b: &[f64]) -> Option<f64> {
+pub(super) fn cosine(a: &[f64], b: &[f64]) -> Option<f64> {
     let dot: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
     let na = a.iter().map(|x| x * x).sum::<f64>().sqrt();
     let nb = b.iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -126,12 +126,12 @@ pub struct Evaluation {
 /// The selected row (spec §5.6 step 4): the applicable row with the largest correlation, where
 /// correlations within [`TIE_TOLERANCE`] of the largest tie and the lowest degree wins.
 /// `None` when no row has a correlation.
-pub fn select_best(rows: &[DegreeResult]) -> Option<&DegreeResult> {
+pub(super) fn select_best(rows: &[DegreeResult]) -> Option<&DegreeResult> {
     select_best_within(rows, TIE_TOLERANCE)
 }
 
 /// [`select_best`] with ties within `tie` (e.g. [`PAPER_TIE_TOLERANCE`]).
-pub fn select_best_within(rows: &[DegreeResult], tie: f64) -> Option<&DegreeResult> {
+pub(super) fn select_best_within(rows: &[DegreeResult], tie: f64) -> Option<&DegreeResult> {
     let best = rows
         .iter()
         .filter(|d| d.applicable)

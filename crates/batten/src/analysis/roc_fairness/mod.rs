@@ -113,9 +113,10 @@ pub use evaluate::{
     DegreeResult, Design, Evaluation, TIE_TOLERANCE, angle_degrees, evaluate, truncate_angle,
 };
 pub(crate) use evaluate::{design_curve, design_samples, evaluate_detailed, fits};
-pub use fit::{MAX_DEGREE, MIN_DEGREE, RhoFit};
-pub use modify::{
+pub(crate) use fit::{MAX_DEGREE, MIN_DEGREE, RhoFit};
+pub(crate) use modify::{
     DEFAULT_MAX_ITERATIONS, Modification, ShapeConstraints, StopReason, modify_shape,
 };
 pub use options::{DEFAULT_METHOD_GRADIENT_FRACTION, DesignEnds, KuraganoOptions, Residual};
-pub use samples::{MAX_SAMPLES, MIN_SAMPLES, RhoSamples};
+pub use samples::MAX_SAMPLES;
+pub(crate) use samples::{MIN_SAMPLES, RhoSamples};

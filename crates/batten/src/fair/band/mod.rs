@@ -77,7 +77,7 @@ use solver::{Problem, solve};
 
 /// A point counts as on the band's edge when its displacement is within this fraction of the
 /// tolerance.
-pub const BAND_EDGE_REL: f64 = 1e-4;
+pub(super) const BAND_EDGE_REL: f64 = 1e-4;
 
 /// How many tolerances the averaging window of the first pass's parameters spans.
 const PARAMETER_WINDOW_TOLERANCES: f64 = 4.0;
@@ -276,7 +276,7 @@ struct Faired<const D: usize> {
 
 /// Above this many points the spline form is tried (`spline.rs`): the point form's solver
 /// stalls from a few thousand points on (see `docs/algorithms/band.md`, Limits).
-pub const DENSE_POINTS: usize = 2000;
+pub(super) const DENSE_POINTS: usize = 2000;
 
 /// Run the passes on points of any dimension and put the result into the band exactly.
 /// `(noise_sigma, noise_dims)`: σ̂ per coordinate and the number of coordinates the noise

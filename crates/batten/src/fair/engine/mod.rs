@@ -11,9 +11,9 @@
 mod budget;
 mod greedy;
 
-pub use budget::MIN_CHORD_REL;
+pub(super) use budget::MIN_CHORD_REL;
 pub(crate) use budget::{max_fraction, step_fraction, tolerance_radius};
-pub use greedy::JUMP_ZERO_REL;
+pub(super) use greedy::JUMP_ZERO_REL;
 pub(crate) use greedy::{
     EPSILON, JUMP_PARAMS, LocalProblem, MaxTree, THRESHOLD, Threshold, drive, driven_parameters,
     move_limit,

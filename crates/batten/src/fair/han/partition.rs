@@ -10,7 +10,7 @@ use crate::geom::{Point, Vec2};
 /// A function segment of a point sequence: points `start..=end` (0-based, inclusive) and the
 /// direction θ (radians) of its local x axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Span {
+pub(super) struct Span {
     /// First point.
     pub start: usize,
     /// Last point (inclusive).
@@ -23,7 +23,7 @@ pub struct Span {
 ///
 /// # Errors
 /// [`Error::NonFinite`], [`Error::DuplicatePoint`] (zero chord).
-pub fn chord_angles(points: &[Point]) -> Result<Vec<f64>> {
+pub(super) fn chord_angles(points: &[Point]) -> Result<Vec<f64>> {
     if let Some(index) = points.iter().position(|p| !p.is_finite()) {
         return Err(Error::NonFinite { index });
     }
@@ -48,7 +48,7 @@ pub fn chord_angles(points: &[Point]) -> Result<Vec<f64>> {
 /// # Errors
 /// As [`chord_angles`].
 #[cfg(test)]
-pub fn turning_angles(points: &[Point]) -> Result<Vec<f64>> {
+pub(super) fn turning_angles(points: &[Point]) -> Result<Vec<f64>> {
     let phi = chord_angles(points)?;
     Ok(unwrap_turning(&phi))
 }
@@ -84,7 +84,7 @@ fn wrap_angle(a: f64) -> f64 {
 /// # Errors
 /// [`Error::TooFewPoints`] for fewer than 2 points, [`Error::InvalidParameter`] for a
 /// `max_turn` outside (0, π] or `overlap` = 0, and the errors of [`chord_angles`].
-pub fn partition(points: &[Point], max_turn: f64, overlap: usize) -> Result<Vec<Span>> {
+pub(super) fn partition(points: &[Point], max_turn: f64, overlap: usize) -> Result<Vec<Span>> {
     if points.len() < 2 {
         return Err(Error::TooFewPoints {
             needed: 2,

@@ -15,7 +15,7 @@ use crate::geom::Point;
 use crate::spline::{CubicSplineFn, FnEndCondition};
 
 /// The fewest points a function segment must have to be faired (spec §1.7).
-pub const MIN_SEGMENT_POINTS: usize = 5;
+pub(super) const MIN_SEGMENT_POINTS: usize = 5;
 /// Rounding-noise floor of the sign tests \[CHOICE\]. Rounding the coordinates (magnitude R) to
 /// double precision puts noise of up to about `0.4·ε·R/h²` into c and `4·0.4·ε·R/h³` into e
 /// (measured on 10⁶ samples of a sine, offset by 100, with spacing h): on dense data every e,
@@ -25,7 +25,7 @@ pub const MIN_SEGMENT_POINTS: usize = 5;
 /// — the factor of the curve metrics' floor. It changes nothing on data whose noise is above
 /// rounding; on a clean curve it keeps `han` from fairing rounding noise (a clean 10⁶-point
 /// spiral made 5.4 million moves without it, none with it).
-pub const ROUNDING_FLOOR_FACTOR: f64 = 64.0;
+pub(super) const ROUNDING_FLOOR_FACTOR: f64 = 64.0;
 
 /// The parameters of the fairing of one function segment.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -202,7 +202,7 @@ impl CaseMove {
 
 /// The five case procedures of one iteration, in the spec's order (§1.7.3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Procedure {
+pub(crate) enum Procedure {
     /// Coarse case 1 ([`Segment::coarse_case1`]).
     CoarseCase1,
     /// Coarse case 2 with its end rules ([`Segment::coarse_case2`]).
@@ -220,7 +220,7 @@ pub enum Procedure {
 
 impl Procedure {
     /// One iteration: phase 1 (cases 1, 2, 3), then phase 2 (cases 1, 2).
-    pub const ITERATION: [Procedure; 5] = [
+    pub(crate) const ITERATION: [Procedure; 5] = [
         Procedure::CoarseCase1,
         Procedure::CoarseCase2,
         Procedure::CoarseCase3,
@@ -438,11 +438,6 @@ impl Segment {
         &self.e
     }
 
-    /// The unit responses of the segment's abscissae.
-    pub fn responses(&self) -> &UnitResponses {
-        &self.resp
-    }
-
     /// The rounding-noise floor of each `c_i` ([`ROUNDING_FLOOR_FACTOR`]).
     pub fn c_floor(&self) -> &[f64] {
         &self.c_floor
@@ -501,7 +496,7 @@ impl Segment {
     }
 
     /// Run one case procedure over the segment, calling `on_move` for every move.
-    pub fn run_procedure(&mut self, p: Procedure, on_move: &mut impl FnMut(&CaseMove)) {
+    pub(crate) fn run_procedure(&mut self, p: Procedure, on_move: &mut impl FnMut(&CaseMove)) {
         match p {
             Procedure::CoarseCase1 => self.coarse_case1_with(on_move),
             Procedure::CoarseCase2 => self.coarse_case2_with(on_move),

@@ -86,7 +86,7 @@ impl LocalProblem for HermiteState {
 }
 
 /// The method parameters [`fair_hermite`] accepts.
-pub const HERMITE_PARAMS: &[ParamSpec] = &JUMP_PARAMS;
+pub(super) const HERMITE_PARAMS: &[ParamSpec] = &JUMP_PARAMS;
 
 /// Fair Hermite data `(t, points, tangents)` by `rule` (spec §2.6 without re-interpolation):
 /// the bad point is the interior point with the largest `|J_k|` of the C¹ Hermite curve, it

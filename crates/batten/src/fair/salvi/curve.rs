@@ -22,14 +22,14 @@ use crate::spline::{BSplineCurve, MAX_ORDER};
 /// A search that lowers the local measure of the moved point by less than this fraction
 /// counts as no progress: the point is skipped until a neighbour makes progress
 /// (`skip_stalled`).
-pub const STALL_REL_IMPROVEMENT: f64 = 1e-3;
+pub(super) const STALL_REL_IMPROVEMENT: f64 = 1e-3;
 
 /// The simplex edge s is this fraction of the mean length of the control-polygon legs at the
 /// moved point (spec §3 step 6).
-pub const SIMPLEX_STEP_REL: f64 = 0.1;
+pub(super) const SIMPLEX_STEP_REL: f64 = 0.1;
 
 /// Simplex evaluation budget per move (spec §3 step 6).
-pub const SIMPLEX_MAX_EVALUATIONS: usize = 400;
+pub(super) const SIMPLEX_MAX_EVALUATIONS: usize = 400;
 
 /// What [`fair_curve`] did, with the sampled curvatures.
 #[derive(Clone, Debug, PartialEq)]
