@@ -193,31 +193,21 @@ mod tests {
     use super::*;
 
     fn row(degree: usize, cos: Option<f64>) -> DegreeResult {
-        DegreeResult {
-            degree,
-            applicable: cos.is_some(),
-            correlation: cos,
-            angle_deg: cos.map(analysis::angle_degrees),
-            s_final: None,
-            rho_rms: None,
-        }
+        DegreeResult::from_correlation(degree, cos)
     }
 
     #[test]
     fn table_prints_truncated_and_full_angles() {
         // Curve F of the paper: six degrees, 0.999800 → 1.1459°, printed 1.14.
-        let e = RocEvaluation {
-            degrees: vec![
-                row(1, Some(0.969)),
-                row(2, Some(0.990)),
-                row(3, None),
-                row(4, Some(0.998)),
-                row(5, Some(0.998)),
-                row(6, Some(0.9998)),
-            ],
-            best_degree: Some(6),
-            fairness: Some(0.9998),
-        };
+        let e = RocEvaluation::from_rows(vec![
+            row(1, Some(0.969)),
+            row(2, Some(0.990)),
+            row(3, None),
+            row(4, Some(0.998)),
+            row(5, Some(0.998)),
+            row(6, Some(0.9998)),
+        ]);
+        assert_eq!((e.best_degree, e.fairness), (Some(6), Some(0.9998)));
         let t = table("f.csv", &e);
         assert!(t.starts_with("f.csv: fairness evaluation"), "{t}");
         assert_eq!(t.lines().count(), 9, "{t}");
@@ -233,11 +223,8 @@ mod tests {
 
     #[test]
     fn table_without_a_best_degree() {
-        let e = RocEvaluation {
-            degrees: (1..=6).map(|d| row(d, None)).collect(),
-            best_degree: None,
-            fairness: None,
-        };
+        let e = RocEvaluation::from_rows((1..=6).map(|d| row(d, None)).collect());
+        assert_eq!((e.best_degree, e.fairness), (None, None));
         assert!(table("s.csv", &e).contains("best: none"));
     }
 }

@@ -127,6 +127,7 @@ pub enum Smoothing {
 
 /// One spline computed during a search (the trace behind [`SmoothingInfo::trials`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct SmoothingTrial {
     /// The smoothing parameter.
     pub p: f64,
@@ -142,6 +143,7 @@ pub struct SmoothingTrial {
 
 /// How p was chosen and what the search saw.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct SmoothingInfo {
     /// The smoothing parameter used.
     pub p: f64,

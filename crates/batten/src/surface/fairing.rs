@@ -298,6 +298,7 @@ pub(crate) struct Problem<'a> {
 
 /// Measurements of one surface.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct SurfaceMeasures {
     /// Π̂ (eq 15) on the `salvi` sample grid with the targets of the *input* surface.
     pub pi_hat: f64,

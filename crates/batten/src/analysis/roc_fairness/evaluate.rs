@@ -91,6 +91,7 @@ impl<'a> From<&'a BSplineCurve> for Design<'a> {
 
 /// One row of the evaluation (a row of the paper's Tables 3 and 4).
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct DegreeResult {
     /// The polynomial degree d.
     pub degree: usize,
@@ -113,6 +114,7 @@ pub struct DegreeResult {
 /// `{"degrees": [{"degree", "applicable", "correlation", "angle_deg"}, ...],
 /// "best_degree", "fairness"}`, with `null` where a value does not exist.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct Evaluation {
     /// Degrees 1..=6 in order.
     pub degrees: Vec<DegreeResult>,
@@ -121,6 +123,36 @@ pub struct Evaluation {
     pub best_degree: Option<usize>,
     /// The cosine of the best degree: the fairness of the design.
     pub fairness: Option<f64>,
+}
+
+impl DegreeResult {
+    /// A row as the paper's tables print it, from its degree and cosine: applicable, with the
+    /// angle of `correlation`, when there is one, not applicable otherwise; the figures of the
+    /// shape modification (`s_final`, `rho_rms`) are absent.
+    pub fn from_correlation(degree: usize, correlation: Option<f64>) -> DegreeResult {
+        DegreeResult {
+            degree,
+            applicable: correlation.is_some(),
+            correlation,
+            angle_deg: correlation.map(angle_degrees),
+            s_final: None,
+            rho_rms: None,
+        }
+    }
+}
+
+impl Evaluation {
+    /// The evaluation made of `degrees`, with the best degree chosen as [`evaluate`] chooses it
+    /// (the largest cosine, ties within [`TIE_TOLERANCE`] to the lowest degree) and its cosine
+    /// as the fairness.
+    pub fn from_rows(degrees: Vec<DegreeResult>) -> Evaluation {
+        let best = select_best(&degrees);
+        Evaluation {
+            best_degree: best.map(|d| d.degree),
+            fairness: best.and_then(|d| d.correlation),
+            degrees,
+        }
+    }
 }
 
 /// The selected row (spec §5.6 step 4): the applicable row with the largest correlation, where

@@ -31,6 +31,7 @@ pub enum KpRule {
 
 /// One move of the bad point `k` of Hermite data (see [`hermite_step`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct HermiteMove {
     /// The new position `r_k + δ`.
     pub point: Point,
