@@ -1,9 +1,26 @@
 //! Measurements of curves: signed curvature and its arc-length derivative, radius of
 //! curvature, arc length, energies, inflections, curvature extrema, curvature-comb samples,
 //! Calì's fairness indicators, the [`FairnessMetrics`] every report carries, and Kuragano &
-//! Yamaguchi's radius-of-curvature fairness evaluation ([`roc_fairness`]).
+//! Yamaguchi's radius-of-curvature fairness evaluation ([`evaluate_roc_fairness`]).
 //!
-//! Everything is generic over the capability traits in [`crate::curve`].
+//! Everything is generic over the capability traits in [`crate::curve`]. The files below are
+//! private modules; this namespace re-exports, by name:
+//!
+//! - curvature and arc length: [`signed_curvature`], [`curvature_at`],
+//!   [`curvature_derivative`], [`radius_of_curvature`], [`curvature_comb`] ([`CombSample`]),
+//!   [`strain_energy`], [`variation_energy`], [`arc_length`], [`ArcLengthTable`];
+//! - fairness measures: [`FairnessMetrics`] (on [`analysis_curve`], with [`ZERO_REL`],
+//!   [`count_sign_changes`] and [`sgn0`] for its sign tests), [`displacement`]
+//!   ([`Displacement`]), Calì's [`fairness_indicators`] ([`FairnessIndicators`]), the noise
+//!   estimates [`noise_sigma`] and [`noise_sigma_space`];
+//! - space curves: [`SpaceCubic`], [`SpaceSample`], [`SpaceDerivatives`], [`SpaceMetrics`];
+//! - Kuragano & Yamaguchi's evaluation (which polynomial ρ(s) a curve follows best, paper
+//!   §4–§5, `batten evaluate`): [`evaluate_roc_fairness`] of a [`RocDesign`] under
+//!   [`KuraganoOptions`] ([`DesignEnds`], [`RhoResidual`]) gives a [`RocEvaluation`], one
+//!   [`DegreeResult`] per degree, with ties within [`ROC_TIE_TOLERANCE`]; [`angle_degrees`]
+//!   and [`truncate_angle`] read a cosine as the paper prints it. Its formulas, choices and
+//!   departures from the paper are in `docs/algorithms/kuragano.md`; the fairing method that
+//!   applies the same shape modification is [`crate::fair::Kuragano`].
 
 mod arclength;
 mod curvature;

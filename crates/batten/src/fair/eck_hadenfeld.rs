@@ -83,24 +83,24 @@ pub(super) const RATIONAL_GRAM_NODES: usize = GaussLegendre::DEFAULT_NODES;
 pub struct EckHadenfeldParams {
     /// Derivative order l of the energy ∫|x^{(l)}|² dt: 2 or 3.
     ///
-    /// Default value: [`DEFAULT_ORDER`] (2).
+    /// Default value: 2.
     pub order: usize,
     /// δ, the largest distance of a control point from its original position; `None`:
-    /// [`local::DEFAULT_TOLERANCE_REL`] × the bounding-box diagonal of the control points.
+    /// 1 % of the bounding-box diagonal of the control points.
     ///
     /// Default value: `None`.
     pub tolerance: Option<f64>,
     /// Length R of the recently-moved list.
     ///
-    /// Default value: [`DEFAULT_TABU_LENGTH`] (4).
+    /// Default value: 4.
     pub tabu_length: usize,
     /// Iteration limit.
     ///
-    /// Default value: [`DEFAULT_MAX_ITERATIONS`] (1000).
+    /// Default value: 1000.
     pub max_iterations: usize,
     /// Stop when no move lowers the energy by more than this fraction of it.
     ///
-    /// Default value: [`DEFAULT_MIN_REL_DECREASE`].
+    /// Default value: 10⁻⁹.
     pub min_rel_decrease: f64,
     /// Let the first and last control points move.
     ///
@@ -411,7 +411,7 @@ pub(super) fn energy(curve: &BSplineCurve, order: usize) -> Result<f64> {
     Ok(Gram::new(curve, order)?.energy(curve.control_points()))
 }
 
-/// Fair `curve` by local energy minimisation (see the module documentation). Knots, degree and
+/// Fair `curve` by local energy minimisation (see `docs/algorithms/salvi-varady.md`). Knots, degree and
 /// weights are kept; every control point stays within δ of its original position, so the
 /// curve stays within δ of `curve` (eq 10).
 ///

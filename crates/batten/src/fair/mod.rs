@@ -10,6 +10,34 @@
 //! Adding a method: implement [`FairMethod`] in a file of its own under `fair/`, declare each
 //! of its parameters once as a `Param` constant (`params.rs`: key, kind with default and
 //! range, doc) and list it in [`methods`].
+//!
+//! # What this namespace exports
+//!
+//! The files below are private modules; what is public is re-exported here by name, the names
+//! of one method prefixed with it where they would be ambiguous:
+//!
+//! - the interface: [`fair`], [`fair_with`], [`fair_curve`] (B-spline input), [`fair_space`]
+//!   (space curves, [`SPACE_METHODS`]), [`method`], [`methods`], [`default_method`],
+//!   [`check_options`], [`catalogue`] ([`MethodInfo`], [`ParamInfo`]); [`FairOptions`],
+//!   [`EndFix`]; what comes back: [`Faired`] with its [`FairReport`] ([`FairStatus`],
+//!   [`Move`], [`HistoryRow`], [`SolverInfo`], [`EndChanges`], [`ToleranceSource`]);
+//!   Han et al.'s comparison protocol [`compare`] ([`Comparison`]);
+//! - the methods, one unit struct each, for [`FairMethod::run`] without the registry:
+//!   [`Mst`], [`Han`], [`Kjellander`], [`Poliakoff`], [`Energy`], [`SapidisFarin`],
+//!   [`Cali`], [`Salvi`], [`EckHadenfeld`], [`Kuragano`], [`Band`]. Each method's equations,
+//!   choices and departures from its paper are in `docs/algorithms/` and in its module's
+//!   documentation in the source (`fair/han/mod.rs`, `fair/salvi/mod.rs`, …);
+//! - the methods' own entry points, with typed parameters: the smoothing spline
+//!   [`SmoothingSpline`] ([`Smoothing`], [`SmoothingInfo`]); [`salvi_fair_curve`]
+//!   ([`SalviParams`], [`SalviSmoother`], [`SalviReport`]) and [`eck_hadenfeld_fair_curve`]
+//!   ([`EckHadenfeldParams`], [`LocalReport`]) on a B-spline; [`fair_hermite`],
+//!   [`hermite_step`] ([`KpRule`], [`HermiteMove`]), [`energy_change_f`] and
+//!   [`parametric_energy`] on Hermite data; [`remove_reinsert_knot`] (Sapidis–Farin);
+//! - two building blocks, for measurements: [`HanSegment`], `han` on one function segment
+//!   ([`HanSegmentParams`], its moves [`HanCaseMove`]), and [`LocalIndicators`], Calì's
+//!   local fairness indicators with their local updates ([`IndicatorTrial`]);
+//! - the documented bounds and factors the methods use ([`MAX_ITERATIONS`],
+//!   [`AUTO_TOLERANCE_K`], [`SALVI_MAX_SAMPLES`], [`BISECTION_REL_PRECISION`], …).
 
 mod band;
 mod cali;

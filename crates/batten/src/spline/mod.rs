@@ -3,8 +3,14 @@
 //! - [`ParametricCubic`]: the C² cubic interpolating spline through planar points;
 //! - [`CubicSplineFn`]: the cubic spline *function* y(x) of HAN (spec §1.2), end conditions
 //!   [`FnEndCondition`];
-//! - [`KnotVector`] and [`BSplineCurve`]: B-spline / NURBS curves of any degree.
+//! - [`KnotVector`] and [`BSplineCurve`]: B-spline / NURBS curves of any degree, with knot
+//!   insertion and removal ([`KnotRemoval`], [`RemovalRule`], [`KnotRef`]);
+//! - [`LambdaOperator`]: the λ-operator of Calì et al.;
+//! - the uniform quintic of Kuragano & Yamaguchi: [`interpolate_quintic`] (ends
+//!   [`QuinticEnds`], end gradients from [`quintic_end_gradients`]),
+//!   [`interpolate_quintic_hermite`], as a B-spline or NURBS ([`QuinticForm`]).
 //!
+//! The files below are private modules; everything public is re-exported here by name.
 //! Nothing here knows about fairing.
 
 mod bspline;

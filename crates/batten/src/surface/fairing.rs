@@ -34,9 +34,9 @@ pub const DEVIATION_MIN_SAMPLES: usize = 51;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SurfaceMethod {
-    /// Salvi & Várady's target-curvature fairing ([`super::salvi`]).
+    /// Salvi & Várady's target-curvature fairing (`surface/salvi.rs`).
     Salvi,
-    /// Eck & Hadenfeld's local thin-plate energy fairing ([`super::eck_hadenfeld`]).
+    /// Eck & Hadenfeld's local thin-plate energy fairing (`surface/eck_hadenfeld.rs`).
     EckHadenfeld,
 }
 
@@ -116,7 +116,7 @@ pub struct SurfaceFairOptions {
     /// Default value: [`SurfaceMethod::Salvi`].
     pub method: SurfaceMethod,
     /// The hard bound δ on `|S_faired(u, v) − S(u, v)|`; `None` for
-    /// [`DEFAULT_TOLERANCE_REL`] × the diagonal of the control net's bounding box.
+    /// 1 % of the diagonal of the control net's bounding box.
     ///
     /// Default value: `None`.
     pub tolerance: Option<f64>,

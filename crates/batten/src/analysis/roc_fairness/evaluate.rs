@@ -26,7 +26,7 @@ use crate::spline::quintic::{self, Ends, QuinticForm};
 /// for degree 2, 0.999800 for degree 6). The paper's own choices in Table 2 (six, 0.99993
 /// against 0.99981 for quintic) and Table 4 (curves A, E, F, H) are kept; its curve B
 /// (quintic 1.56° against quartic 1.58°, cosines 10⁻⁵ apart) would be quartic.
-/// [`select_best_within`] with [`PAPER_TIE_TOLERANCE`] reproduces the paper's choices.
+/// A tie tolerance of 10⁻⁶ reproduces the paper's choices.
 pub const TIE_TOLERANCE: f64 = 1e-4;
 
 /// The tie tolerance that reproduces every choice of the paper's Table 4 (curve B
@@ -66,8 +66,8 @@ pub fn truncate_angle(deg: f64, decimals: u32) -> f64 {
 pub enum Design<'a> {
     /// A point sequence; the design is its uniform quintic interpolant.
     Points(&'a [Point]),
-    /// A non-rational B-spline (any degree and knots; the quintic of
-    /// [`crate::spline::quintic`] in the paper).
+    /// A non-rational B-spline (any degree and knots; in the paper the uniform quintic of
+    /// [`crate::spline::interpolate_quintic`]).
     Curve(&'a BSplineCurve),
 }
 
@@ -296,7 +296,7 @@ pub(crate) fn evaluate_detailed(
 ///
 /// ```
 /// use batten::Point;
-/// use batten::analysis::roc_fairness::{KuraganoOptions, evaluate};
+/// use batten::analysis::{KuraganoOptions, evaluate_roc_fairness};
 ///
 /// // A spiral arc: ρ grows with the arc length, no inflection.
 /// let pts: Vec<Point> = (0..16)
@@ -306,12 +306,12 @@ pub(crate) fn evaluate_detailed(
 ///         Point::new(r * a.cos(), r * a.sin())
 ///     })
 ///     .collect();
-/// let e = evaluate(&pts, &KuraganoOptions::default())?;
+/// let e = evaluate_roc_fairness(&pts, &KuraganoOptions::default())?;
 /// assert_eq!(e.degrees.len(), 6);
 /// assert!(e.best_degree.is_some() && e.fairness.is_some_and(|c| c > 0.99));
 /// // An S-shaped design has no applicable degree.
 /// let s: Vec<Point> = (0..16).map(|i| Point::new(i as f64, (0.4 * i as f64).sin())).collect();
-/// assert_eq!(evaluate(&s, &KuraganoOptions::default())?.best_degree, None);
+/// assert_eq!(evaluate_roc_fairness(&s, &KuraganoOptions::default())?.best_degree, None);
 /// # Ok::<(), batten::Error>(())
 /// ```
 ///

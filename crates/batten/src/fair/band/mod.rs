@@ -105,7 +105,7 @@ pub fn auto_k(n: usize) -> f64 {
     AUTO_TOLERANCE_K.max((2.0 * (n.max(1) as f64).ln()).sqrt())
 }
 
-/// The `band` method.
+/// The `band` method (see `docs/algorithms/band.md`).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Band;
 

@@ -168,7 +168,8 @@ const DEGREE: Param<Number<usize>> = Param {
 
 static PARAMS: &[ParamSpec] = &[TAU.spec(), LAMBDA_TOL.spec(), DEGREE.spec()];
 
-/// The `cali` fairing method (see the module documentation).
+/// The `cali` fairing method (see `docs/algorithms/cali.md`, and the module docs of
+/// `fair/cali/mod.rs` in the source).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Cali;
 

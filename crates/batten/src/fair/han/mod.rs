@@ -136,7 +136,8 @@ use params::{HanParams, PARAMS};
 use pipeline::{Passes, RunLog, run_passes};
 pub use segment::{CaseMove, MoveTag, Segment, SegmentParams};
 
-/// The `han` method: see the module documentation.
+/// The `han` method: see `docs/algorithms/han.md`, and the module docs of `fair/han/mod.rs` in
+/// the source.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Han;
 

@@ -64,7 +64,8 @@ use crate::geom::PointSeq;
 use params::{LENGTH_PARAMS, PARAMS};
 use run::run_points;
 
-/// The `kuragano` fairing method (see the module docs).
+/// The `kuragano` fairing method (see `docs/algorithms/kuragano.md`, and the module docs of
+/// `fair/kuragano/mod.rs` in the source).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Kuragano;
 

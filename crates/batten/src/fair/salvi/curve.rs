@@ -127,13 +127,15 @@ impl Samples {
     }
 }
 
-/// Fair `curve` by Salvi & Várady's method (see the module documentation). Knots, degree
+/// Fair `curve` by Salvi & Várady's method (see `docs/algorithms/salvi-varady.md`). Knots, degree
 /// and weights are kept; the result is within δ of `curve` at every parameter.
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] for a degree below 2, fewer than [`MIN_SAMPLES`] samples, a
-/// non-positive tolerance; [`Error::Degenerate`] when the curvature is undefined at a sample;
-/// the errors of [`target_curvature`].
+/// [`Error::InvalidParameter`] for a degree below 2, fewer than 4 samples, a non-positive
+/// tolerance; [`Error::Degenerate`] when the curvature is undefined at a sample; the errors of
+/// the target curvature ([`Error::LengthMismatch`] for a given target of the wrong length,
+/// [`Error::InvalidParameter`] for a B-spline fit with fewer than 4 coefficients,
+/// [`Error::Degenerate`] for a curve of zero length or zero speed, [`Error::Singular`]).
 pub fn fair_curve(
     curve: &BSplineCurve,
     params: &SalviParams,
