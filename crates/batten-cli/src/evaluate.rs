@@ -7,8 +7,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::anyhow;
-use batten::analysis::roc_fairness::{
-    self, DEFAULT_METHOD_GRADIENT_FRACTION, DesignEnds, Evaluation, KuraganoOptions, Residual,
+use batten::analysis::{
+    self, DEFAULT_METHOD_GRADIENT_FRACTION, DesignEnds, KuraganoOptions, RhoResidual, RocEvaluation,
 };
 use batten::io;
 use clap::{Args, ValueEnum};
@@ -76,8 +76,8 @@ pub fn run(args: &EvaluateArgs) -> Result<ExitCode, Failure> {
         .to_string();
     let mut opts = KuraganoOptions::default()
         .with_residual(match args.residual {
-            ResidualArg::Rho => Residual::Rho,
-            ResidualArg::Kappa => Residual::Kappa,
+            ResidualArg::Rho => RhoResidual::Rho,
+            ResidualArg::Kappa => RhoResidual::Kappa,
         })
         .with_ends(match args.ends {
             EndsArg::Gradients => DesignEnds::Gradients {
@@ -98,14 +98,14 @@ pub fn run(args: &EvaluateArgs) -> Result<ExitCode, Failure> {
         crate::formats::read_input(&args.input, format, false, &io::Pick::default())?.source;
     let evaluation = match source {
         io::Source::Space(_) => return Err(crate::input::space_not_planar(&args.input)),
-        io::Source::Curve(c) => roc_fairness::evaluate(&c, &opts),
+        io::Source::Curve(c) => analysis::evaluate_roc_fairness(&c, &opts),
         io::Source::Points(data) => {
             if data.seq.is_closed() {
                 return Err(Failure::usage(anyhow!(
                     "{name}: the fairness evaluation needs an open curve"
                 )));
             }
-            roc_fairness::evaluate(data.seq.points(), &opts)
+            analysis::evaluate_roc_fairness(data.seq.points(), &opts)
         }
     }
     .map_err(|e| Failure::from_batten(&what, e))?;
@@ -123,7 +123,7 @@ pub fn run(args: &EvaluateArgs) -> Result<ExitCode, Failure> {
 
 /// The table: one row per degree as in the paper's Tables 3 (cosine) and 4 (angle, truncated
 /// to two decimals), with the full angle beside it.
-fn table(name: &str, e: &Evaluation) -> String {
+fn table(name: &str, e: &RocEvaluation) -> String {
     let mut s = format!("{name}: fairness evaluation (Kuragano & Yamaguchi)\n");
     // Writing to a String cannot fail.
     let _ = writeln!(
@@ -139,10 +139,7 @@ fn table(name: &str, e: &Evaluation) -> String {
         let (cos, short, full) = match (d.correlation, d.angle_deg) {
             (Some(c), Some(a)) => (
                 format!("{c:.COSINE_DECIMALS$}"),
-                format!(
-                    "{:.2}",
-                    roc_fairness::truncate_angle(a, PAPER_ANGLE_DECIMALS)
-                ),
+                format!("{:.2}", analysis::truncate_angle(a, PAPER_ANGLE_DECIMALS)),
                 format!("{a:.10}"),
             ),
             _ => ("-".to_string(), "-".to_string(), "-".to_string()),
@@ -167,12 +164,12 @@ fn table(name: &str, e: &Evaluation) -> String {
                 .filter_map(|r| r.correlation)
                 .fold(f64::NEG_INFINITY, f64::max);
             if max > f {
-                // A tie (roc_fairness::TIE_TOLERANCE) went to the lower degree: say so.
+                // A tie (analysis::ROC_TIE_TOLERANCE) went to the lower degree: say so.
                 let _ = write!(
                     s,
                     " (the lowest degree within {:e} of the largest correlation, \
                      {max:.COSINE_DECIMALS$})",
-                    roc_fairness::TIE_TOLERANCE
+                    analysis::ROC_TIE_TOLERANCE
                 );
             }
             let _ = writeln!(s);
@@ -191,36 +188,26 @@ fn table(name: &str, e: &Evaluation) -> String {
 #[cfg(test)]
 #[allow(clippy::unwrap_used)]
 mod tests {
-    use batten::analysis::roc_fairness::DegreeResult;
+    use batten::analysis::DegreeResult;
 
     use super::*;
 
     fn row(degree: usize, cos: Option<f64>) -> DegreeResult {
-        DegreeResult {
-            degree,
-            applicable: cos.is_some(),
-            correlation: cos,
-            angle_deg: cos.map(roc_fairness::angle_degrees),
-            s_final: None,
-            rho_rms: None,
-        }
+        DegreeResult::from_correlation(degree, cos)
     }
 
     #[test]
     fn table_prints_truncated_and_full_angles() {
         // Curve F of the paper: six degrees, 0.999800 → 1.1459°, printed 1.14.
-        let e = Evaluation {
-            degrees: vec![
-                row(1, Some(0.969)),
-                row(2, Some(0.990)),
-                row(3, None),
-                row(4, Some(0.998)),
-                row(5, Some(0.998)),
-                row(6, Some(0.9998)),
-            ],
-            best_degree: Some(6),
-            fairness: Some(0.9998),
-        };
+        let e = RocEvaluation::from_rows(vec![
+            row(1, Some(0.969)),
+            row(2, Some(0.990)),
+            row(3, None),
+            row(4, Some(0.998)),
+            row(5, Some(0.998)),
+            row(6, Some(0.9998)),
+        ]);
+        assert_eq!((e.best_degree, e.fairness), (Some(6), Some(0.9998)));
         let t = table("f.csv", &e);
         assert!(t.starts_with("f.csv: fairness evaluation"), "{t}");
         assert_eq!(t.lines().count(), 9, "{t}");
@@ -236,11 +223,8 @@ mod tests {
 
     #[test]
     fn table_without_a_best_degree() {
-        let e = Evaluation {
-            degrees: (1..=6).map(|d| row(d, None)).collect(),
-            best_degree: None,
-            fairness: None,
-        };
+        let e = RocEvaluation::from_rows((1..=6).map(|d| row(d, None)).collect());
+        assert_eq!((e.best_degree, e.fairness), (None, None));
         assert!(table("s.csv", &e).contains("best: none"));
     }
 }

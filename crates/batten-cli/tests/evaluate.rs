@@ -45,7 +45,7 @@ fn evaluate_json_has_the_documented_shape() {
     let fairness = v["fairness"].as_f64().unwrap();
     assert_eq!(fairness, degrees[best - 1]["correlation"].as_f64().unwrap());
     assert!(fairness > 0.999, "{fairness}");
-    // The best degree is the lowest within TIE_TOLERANCE of the largest correlation.
+    // The best degree is the lowest within ROC_TIE_TOLERANCE of the largest correlation.
     let max = degrees
         .iter()
         .map(|d| d["correlation"].as_f64().unwrap())
@@ -53,7 +53,7 @@ fn evaluate_json_has_the_documented_shape() {
     let lowest = degrees
         .iter()
         .position(|d| {
-            d["correlation"].as_f64().unwrap() >= max - batten::fair::kuragano::TIE_TOLERANCE
+            d["correlation"].as_f64().unwrap() >= max - batten::analysis::ROC_TIE_TOLERANCE
         })
         .unwrap();
     assert_eq!(best, lowest + 1);

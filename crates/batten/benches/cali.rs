@@ -15,8 +15,7 @@ mod common;
 
 use std::hint::black_box;
 
-use batten::fair::cali::LocalIndicators;
-use batten::fair::{Cali, FairMethod};
+use batten::fair::{Cali, FairMethod, LocalIndicators};
 use batten::spline::{BSplineCurve, LambdaOperator, Parametrization};
 use batten::{FairOptions, Point, PointSeq};
 use common::noisy_spiral;

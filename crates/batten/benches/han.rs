@@ -14,8 +14,7 @@ mod common;
 
 use std::hint::black_box;
 
-use batten::fair::han::Segment;
-use batten::fair::{FairMethod, Han};
+use batten::fair::{FairMethod, Han, HanSegment};
 use batten::{FairOptions, PointSeq};
 use common::{noisy_spiral, uniform_noise};
 use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
@@ -24,7 +23,7 @@ const SIZES: [usize; 4] = [1_000, 10_000, 100_000, 1_000_000];
 
 /// One function segment: `x_i = i·h` over three periods of `y = sin(x/2)`, with the same
 /// deterministic wobble of 1% of h on y.
-fn segment(n: usize) -> Segment {
+fn segment(n: usize) -> HanSegment {
     let mut noise = uniform_noise();
     let h = 12.0 * std::f64::consts::PI / n as f64;
     let x: Vec<f64> = (0..n).map(|i| i as f64 * h).collect();
@@ -32,7 +31,7 @@ fn segment(n: usize) -> Segment {
         .iter()
         .map(|&v| (v / 2.0).sin() + 0.01 * h * noise())
         .collect();
-    Segment::new(x, y).unwrap()
+    HanSegment::new(x, y).unwrap()
 }
 
 fn bench(c: &mut Criterion) {

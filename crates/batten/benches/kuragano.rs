@@ -11,9 +11,11 @@ mod common;
 
 use std::hint::black_box;
 
-use batten::fair::FairMethod;
-use batten::fair::kuragano::Kuragano;
-use batten::spline::quintic::{self, Ends, QuinticForm};
+use batten::fair::{FairMethod, Kuragano};
+use batten::spline::{
+    QuinticEnds, QuinticForm, interpolate_quintic, interpolate_quintic_hermite,
+    quintic_end_gradients,
+};
 use batten::{FairOptions, Point, PointSeq, Vec2};
 use common::noisy_spiral;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
@@ -32,12 +34,14 @@ fn bench(c: &mut Criterion) {
         let pts = noisy_spiral(n, 3.0, 0.01);
         g.throughput(Throughput::Elements(n as u64));
         g.bench_with_input(BenchmarkId::new("natural", n), &n, |b, _| {
-            b.iter(|| quintic::interpolate(black_box(&pts), &Ends::Natural, QuinticForm::BSpline))
+            b.iter(|| {
+                interpolate_quintic(black_box(&pts), &QuinticEnds::Natural, QuinticForm::BSpline)
+            })
         });
-        let grads = quintic::end_gradients(&pts, 1.0).unwrap();
-        let ends = Ends::Gradients(grads);
+        let grads = quintic_end_gradients(&pts, 1.0).unwrap();
+        let ends = QuinticEnds::Gradients(grads);
         g.bench_with_input(BenchmarkId::new("gradients", n), &n, |b, _| {
-            b.iter(|| quintic::interpolate(black_box(&pts), &ends, QuinticForm::BSpline))
+            b.iter(|| interpolate_quintic(black_box(&pts), &ends, QuinticForm::BSpline))
         });
         let every: Vec<Vec2> = pts
             .windows(2)
@@ -45,7 +49,7 @@ fn bench(c: &mut Criterion) {
             .chain(std::iter::once(pts[n - 1] - pts[n - 2]))
             .collect();
         g.bench_with_input(BenchmarkId::new("hermite_least_squares", n), &n, |b, _| {
-            b.iter(|| quintic::interpolate_hermite(black_box(&pts), &every, QuinticForm::BSpline))
+            b.iter(|| interpolate_quintic_hermite(black_box(&pts), &every, QuinticForm::BSpline))
         });
     }
     // Degenerate input: collinear points (every end-condition right-hand side is zero).
@@ -53,7 +57,13 @@ fn bench(c: &mut Criterion) {
         .map(|i| Point::new(i as f64, 2.0 * i as f64))
         .collect();
     g.bench_function("natural_collinear/100000", |b| {
-        b.iter(|| quintic::interpolate(black_box(&line), &Ends::Natural, QuinticForm::BSpline))
+        b.iter(|| {
+            interpolate_quintic(
+                black_box(&line),
+                &QuinticEnds::Natural,
+                QuinticForm::BSpline,
+            )
+        })
     });
     g.finish();
 

@@ -10,8 +10,7 @@ mod common;
 use std::hint::black_box;
 
 use batten::Point;
-use batten::fair::eck_hadenfeld::{self, EckHadenfeldParams};
-use batten::fair::salvi::{self, SalviParams};
+use batten::fair::{EckHadenfeldParams, SalviParams, eck_hadenfeld_fair_curve, salvi_fair_curve};
 use batten::spline::{BSplineCurve, KnotVector};
 use common::uniform_noise;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
@@ -59,10 +58,10 @@ fn bench(c: &mut Criterion) {
     for n in SIZES {
         let curve = noisy_curve(n);
         g.bench_with_input(BenchmarkId::new("salvi", n), &n, |b, _| {
-            b.iter(|| salvi::fair_curve(black_box(&curve), &salvi_params).expect("salvi"))
+            b.iter(|| salvi_fair_curve(black_box(&curve), &salvi_params).expect("salvi"))
         });
         g.bench_with_input(BenchmarkId::new("eck-hadenfeld", n), &n, |b, _| {
-            b.iter(|| eck_hadenfeld::fair_curve(black_box(&curve), &eh_params).expect("eh"))
+            b.iter(|| eck_hadenfeld_fair_curve(black_box(&curve), &eh_params).expect("eh"))
         });
     }
     // Degenerate input: a straight line with one bumped control point (κ = 0 away from the
@@ -77,10 +76,10 @@ fn bench(c: &mut Criterion) {
         None,
     );
     g.bench_function("salvi/line-bump-1000", |b| {
-        b.iter(|| salvi::fair_curve(black_box(&line), &salvi_params).expect("salvi"))
+        b.iter(|| salvi_fair_curve(black_box(&line), &salvi_params).expect("salvi"))
     });
     g.bench_function("eck-hadenfeld/line-bump-1000", |b| {
-        b.iter(|| eck_hadenfeld::fair_curve(black_box(&line), &eh_params).expect("eh"))
+        b.iter(|| eck_hadenfeld_fair_curve(black_box(&line), &eh_params).expect("eh"))
     });
     g.finish();
 }

@@ -11,8 +11,14 @@
 //! - [`spline`]: spline representations and their constructors;
 //! - [`analysis`]: curvature, arc length, inflections, energies, [`FairnessMetrics`];
 //! - [`fair`]: the fairing methods behind one interface ([`fair::fair`]);
-//! - [`io`]: point lists and curves in CSV and JSON;
-//! - `plot`: SVG pictures of curves, curvature combs and curvature graphs (feature `plot`).
+//! - [`io`]: point lists and curves in CSV, JSON, DXF, IGES and SVG;
+//! - [`surface`]: B-spline surfaces, their interrogation and fairing;
+//! - `plot`: SVG pictures of curves, curvature combs and curvature graphs (feature `plot`);
+//! - [`error`]: the [`Error`] every fallible function returns.
+//!
+//! Each namespace re-exports its items by name, flat; the files below it are private modules
+//! (each namespace's documentation lists what it exports). The most used names are also here
+//! at the root.
 //!
 //! ```
 //! use batten::{fair, FairOptions, Point, PointSeq};
@@ -31,6 +37,8 @@
 //! assert!(out.report.max_displacement <= 0.01);
 //! assert!(out.report.tolerance_met);
 //! ```
+
+#![warn(unreachable_pub)]
 
 pub mod analysis;
 pub mod curve;

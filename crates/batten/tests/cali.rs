@@ -5,8 +5,7 @@
 
 use batten::analysis::fairness_indicators;
 use batten::curve::{Curve, CurveDeriv};
-use batten::fair::cali::LocalIndicators;
-use batten::fair::{FairStatus, fair};
+use batten::fair::{FairStatus, LocalIndicators, fair};
 use batten::spline::{BSplineCurve, KnotVector, LambdaOperator, Parametrization};
 use batten::{Error, FairOptions, Point, PointSeq};
 use proptest::prelude::*;

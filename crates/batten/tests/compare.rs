@@ -5,8 +5,9 @@
 #![allow(clippy::unwrap_used)]
 
 use batten::error::Error;
-use batten::fair::smoothing::BISECTION_REL_PRECISION;
-use batten::fair::{self, Comparison, ComparisonOutcome, EndFix, FairMethod};
+use batten::fair::{
+    self, BISECTION_REL_PRECISION, Comparison, ComparisonOutcome, EndFix, FairMethod,
+};
 use batten::{FairOptions, PointSeq};
 
 mod common;

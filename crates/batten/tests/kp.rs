@@ -5,8 +5,10 @@
 #![allow(clippy::unwrap_used)]
 
 use batten::curve::{Curve, CurveDeriv};
-use batten::fair::kjellander::{energy_change_f, parametric_energy};
-use batten::fair::{self, FairStatus, KpRule, fair_hermite, hermite_step, remove_reinsert_knot};
+use batten::fair::{
+    self, FairStatus, KpRule, energy_change_f, fair_hermite, hermite_step, parametric_energy,
+    remove_reinsert_knot,
+};
 use batten::spline::{
     BSplineCurve, EndCondition, KnotRef, ParametricCubic, Parametrization, RemovalRule, parameters,
 };

@@ -3,8 +3,8 @@
 //! work (so that `batch` refuses it before reading a file); points closer than rounding are
 //! refused by name instead of making a solver singular.
 
+use batten::analysis::{KuraganoOptions, ROC_MAX_SAMPLES, evaluate_roc_fairness};
 use batten::error::Error;
-use batten::fair::kuragano::{self, KuraganoOptions};
 use batten::fair::{MAX_ITERATIONS, check_options, fair, method};
 use batten::geom::NEAR_DUPLICATE_REL;
 use batten::{FairOptions, Point, PointSeq};
@@ -42,10 +42,10 @@ fn kuragano_samples_are_bounded() {
         usize::MAX,
         100_000_000_000,
         100_000_000,
-        kuragano::MAX_SAMPLES + 1,
+        ROC_MAX_SAMPLES + 1,
     ] {
         let opts = KuraganoOptions::default().with_samples(n);
-        assert_refused(kuragano::evaluate(&pts, &opts).map(|_| ()), "samples");
+        assert_refused(evaluate_roc_fairness(&pts, &opts).map(|_| ()), "samples");
         let fo = FairOptions::default().with_param("samples", n);
         assert_refused(
             check_options(method("kuragano").unwrap(), false, &fo),
@@ -53,7 +53,7 @@ fn kuragano_samples_are_bounded() {
         );
     }
     // The bound itself is accepted.
-    let fo = FairOptions::default().with_param("samples", kuragano::MAX_SAMPLES);
+    let fo = FairOptions::default().with_param("samples", ROC_MAX_SAMPLES);
     check_options(method("kuragano").unwrap(), false, &fo).expect("at the bound");
 }
 
@@ -61,11 +61,11 @@ fn kuragano_samples_are_bounded() {
 fn salvi_samples_are_bounded() {
     // `--method salvi --set samples=1000000` ran for more than 5 minutes.
     let m = method("salvi").unwrap();
-    for n in [usize::MAX, 1_000_000, batten::fair::salvi::MAX_SAMPLES + 1] {
+    for n in [usize::MAX, 1_000_000, batten::fair::SALVI_MAX_SAMPLES + 1] {
         let fo = FairOptions::default().with_param("samples", n);
         assert_refused(check_options(m, false, &fo), "samples");
     }
-    let fo = FairOptions::default().with_param("samples", batten::fair::salvi::MAX_SAMPLES);
+    let fo = FairOptions::default().with_param("samples", batten::fair::SALVI_MAX_SAMPLES);
     check_options(m, false, &fo).expect("at the bound");
 }
 

@@ -18,6 +18,7 @@ use crate::spline::BSplineCurve;
 
 /// The indicators of a B-spline curve, at its Greville points.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct FairnessIndicators {
     /// Greville abscissae ξ_0..ξ_m.
     pub xi: Vec<f64>,

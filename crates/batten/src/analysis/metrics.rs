@@ -200,6 +200,7 @@ pub fn count_sign_changes(values: &[f64], cyclic: bool) -> usize {
 /// spline through them with chord-length parameters, not-a-knot ends for an open curve
 /// (\[CHOICE\]: it imposes no artificial zero curvature at the ends) and periodic for a closed one.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct FairnessMetrics {
     /// Number of points.
     pub points: usize,
@@ -637,6 +638,7 @@ impl<const N: usize> SampleTerms<N> {
 
 /// Displacement between two point sets of equal length.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct Displacement {
     /// Largest distance `|a_i − b_i|`.
     pub max: f64,

@@ -34,7 +34,7 @@ use crate::geom::Point;
 pub const MAD_TO_SIGMA: f64 = 1.482_6;
 
 /// From this many points the fifth differences are used, below it the third.
-pub const FIFTH_ORDER_POINTS: usize = 8;
+pub(super) const FIFTH_ORDER_POINTS: usize = 8;
 
 /// The coefficients of the third and fifth differences and the standard deviation each gives
 /// unit-variance independent noise, `√C(2k, k)`.

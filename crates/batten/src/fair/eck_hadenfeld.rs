@@ -61,21 +61,21 @@ use crate::numeric::GaussLegendre;
 use crate::spline::{BSplineCurve, MAX_ORDER};
 
 /// Default derivative order l of the energy.
-pub const DEFAULT_ORDER: usize = 2;
+pub(super) const DEFAULT_ORDER: usize = 2;
 
 /// Default iteration limit (one control point per iteration).
-pub const DEFAULT_MAX_ITERATIONS: usize = 1000;
+pub(super) const DEFAULT_MAX_ITERATIONS: usize = 1000;
 
 /// Stop when the best single move would lower the energy by less than this fraction of it.
-pub const DEFAULT_MIN_REL_DECREASE: f64 = 1e-9;
+pub(super) const DEFAULT_MIN_REL_DECREASE: f64 = 1e-9;
 
 /// Fewest points of a closed curve: the cyclic band of the Gram matrix (half-width 3) must
 /// not wrap onto itself.
-pub const MIN_CLOSED_CONTROL_POINTS: usize = 8;
+pub(super) const MIN_CLOSED_CONTROL_POINTS: usize = 8;
 
 /// Gauss–Legendre nodes per span for the Gram matrix of a rational curve (its integrand is not
 /// a polynomial).
-pub const RATIONAL_GRAM_NODES: usize = GaussLegendre::DEFAULT_NODES;
+pub(super) const RATIONAL_GRAM_NODES: usize = GaussLegendre::DEFAULT_NODES;
 
 /// Parameters of [`fair_curve`]. Start from [`EckHadenfeldParams::DEFAULT`].
 #[derive(Clone, Debug, PartialEq)]
@@ -83,24 +83,24 @@ pub const RATIONAL_GRAM_NODES: usize = GaussLegendre::DEFAULT_NODES;
 pub struct EckHadenfeldParams {
     /// Derivative order l of the energy ∫|x^{(l)}|² dt: 2 or 3.
     ///
-    /// Default value: [`DEFAULT_ORDER`] (2).
+    /// Default value: 2.
     pub order: usize,
     /// δ, the largest distance of a control point from its original position; `None`:
-    /// [`local::DEFAULT_TOLERANCE_REL`] × the bounding-box diagonal of the control points.
+    /// 1 % of the bounding-box diagonal of the control points.
     ///
     /// Default value: `None`.
     pub tolerance: Option<f64>,
     /// Length R of the recently-moved list.
     ///
-    /// Default value: [`DEFAULT_TABU_LENGTH`] (4).
+    /// Default value: 4.
     pub tabu_length: usize,
     /// Iteration limit.
     ///
-    /// Default value: [`DEFAULT_MAX_ITERATIONS`] (1000).
+    /// Default value: 1000.
     pub max_iterations: usize,
     /// Stop when no move lowers the energy by more than this fraction of it.
     ///
-    /// Default value: [`DEFAULT_MIN_REL_DECREASE`].
+    /// Default value: 10⁻⁹.
     pub min_rel_decrease: f64,
     /// Let the first and last control points move.
     ///
@@ -193,7 +193,7 @@ impl Default for EckHadenfeldParams {
 /// The band of the Gram matrix `G_ab = ∫ R_a^{(l)}(t) R_b^{(l)}(t) dt` of a B-spline's
 /// (rational) basis functions over its domain.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Gram {
+pub(super) struct Gram {
     p: usize,
     n: usize,
     /// `band[a·(p+1) + k] = G[a][a+k]`, k = 0..=p (indices mod n when `cyclic`).
@@ -208,7 +208,7 @@ impl Gram {
     /// # Errors
     /// [`Error::InvalidParameter`] for an order outside `1..=3` or above the degree (the
     /// energy would vanish identically).
-    pub fn new(curve: &BSplineCurve, order: usize) -> Result<Gram> {
+    pub(super) fn new(curve: &BSplineCurve, order: usize) -> Result<Gram> {
         let p = curve.degree();
         check_order(order, p)?;
         let n = curve.control_points().len();
@@ -288,7 +288,7 @@ impl Gram {
     }
 
     /// `G[a][b]` (zero outside the band).
-    pub fn get(&self, a: usize, b: usize) -> f64 {
+    pub(super) fn get(&self, a: usize, b: usize) -> f64 {
         if self.cyclic {
             let k = (b + self.n - a) % self.n;
             return if k <= self.p {
@@ -318,13 +318,8 @@ impl Gram {
         (lo..hi).map(move |i| if cyclic { i % n } else { i })
     }
 
-    /// Half-bandwidth p.
-    pub fn bandwidth(&self) -> usize {
-        self.p
-    }
-
     /// `Σ_{i≠j} G_ji d_i`, the coupling of control point j to the others.
-    pub fn coupling(&self, d: &[Point], j: usize) -> Vec2 {
+    pub(super) fn coupling(&self, d: &[Point], j: usize) -> Vec2 {
         let mut s = Vec2::ZERO;
         for i in self.neighbours(j) {
             if i != j {
@@ -338,7 +333,7 @@ impl Gram {
     ///
     /// # Panics
     /// If `d` has fewer entries than the matrix.
-    pub fn energy(&self, d: &[Point]) -> f64 {
+    pub(super) fn energy(&self, d: &[Point]) -> f64 {
         let mut e = 0.0;
         for (a, pa) in d.iter().enumerate().take(self.n) {
             let da = pa.to_vec2();
@@ -411,11 +406,12 @@ fn rational_derivative(b: &[[f64; MAX_ORDER]; 4], w: &[f64], o: usize, out: &mut
 ///
 /// # Errors
 /// As [`Gram::new`].
-pub fn energy(curve: &BSplineCurve, order: usize) -> Result<f64> {
+#[cfg(test)]
+pub(super) fn energy(curve: &BSplineCurve, order: usize) -> Result<f64> {
     Ok(Gram::new(curve, order)?.energy(curve.control_points()))
 }
 
-/// Fair `curve` by local energy minimisation (see the module documentation). Knots, degree and
+/// Fair `curve` by local energy minimisation (see `docs/algorithms/salvi-varady.md`). Knots, degree and
 /// weights are kept; every control point stays within δ of its original position, so the
 /// curve stays within δ of `curve` (eq 10).
 ///

@@ -31,19 +31,19 @@ use crate::geom::{BBox, Point, PointSeq};
 use crate::spline::{BSplineCurve, KnotVector, Parametrization};
 
 /// Length R of the recently-moved list (spec §3 step 5).
-pub const DEFAULT_TABU_LENGTH: usize = 4;
+pub(crate) const DEFAULT_TABU_LENGTH: usize = 4;
 
 /// Without a tolerance, δ is this fraction of the diagonal of the bounding box of the data
 /// (the input points, or the control points of a B-spline given directly).
-pub const DEFAULT_TOLERANCE_REL: f64 = 0.01;
+pub(crate) const DEFAULT_TOLERANCE_REL: f64 = 0.01;
 
 /// δ used for point input is reduced by this many units of `f64::EPSILON` times the
 /// coordinate magnitude, so that rounding in the clamp and in evaluation cannot push an output
 /// point past the tolerance the user asked for.
-pub const ROUNDING_MARGIN_ULPS: f64 = 64.0;
+pub(crate) const ROUNDING_MARGIN_ULPS: f64 = 64.0;
 
 /// Degree of the B-spline fitted to point input (global interpolation, spec §0.5).
-pub const DEFAULT_FIT_DEGREE: usize = 3;
+pub(crate) const DEFAULT_FIT_DEGREE: usize = 3;
 
 /// The eq-11 clamp (spec §3 step 7): when `|proposed − original| > δ`, return
 /// `original + δ·(proposed − original)/|proposed − original|`, else `proposed`. The flag says
@@ -51,7 +51,7 @@ pub const DEFAULT_FIT_DEGREE: usize = 3;
 ///
 /// `original` is the control point of the *unfaired* curve, so a run of many moves never
 /// drifts farther than δ from it.
-pub fn clamp_to_original<const D: usize>(
+pub(crate) fn clamp_to_original<const D: usize>(
     original: &[f64; D],
     proposed: &[f64; D],
     delta: f64,
@@ -74,7 +74,7 @@ pub fn clamp_to_original<const D: usize>(
 }
 
 /// [`clamp_to_original`] for planar points.
-pub fn clamp_point(original: Point, proposed: Point, delta: f64) -> (Point, bool) {
+pub(crate) fn clamp_point(original: Point, proposed: Point, delta: f64) -> (Point, bool) {
     let (p, clamped) =
         clamp_to_original(&[original.x, original.y], &[proposed.x, proposed.y], delta);
     (Point::from(p), clamped)
@@ -90,7 +90,7 @@ pub fn clamp_point(original: Point, proposed: Point, delta: f64) -> (Point, bool
 /// # Errors
 /// [`Error::InvalidParameter`] when the samples are not finite and non-decreasing, or the
 /// knot vector does not fit `degree` and `n_ctrl`.
-pub fn support_ranges(
+pub(crate) fn support_ranges(
     knots: &KnotVector,
     degree: usize,
     n_ctrl: usize,
@@ -136,7 +136,7 @@ pub fn support_ranges(
 
 /// `n ≥ 2` uniform parameters `t_i = t_min + i (t_max − t_min)/(n − 1)` over `domain`, the last
 /// one exactly `t_max` (spec §3 step 2). `n < 2` gives `[t_min]` or nothing.
-pub fn uniform_samples(domain: (f64, f64), n: usize) -> Vec<f64> {
+pub(crate) fn uniform_samples(domain: (f64, f64), n: usize) -> Vec<f64> {
     let (a, b) = domain;
     match n {
         0 => Vec::new(),
@@ -155,14 +155,14 @@ pub fn uniform_samples(domain: (f64, f64), n: usize) -> Vec<f64> {
 /// capacity R (the oldest entry leaves when a new one arrives at capacity). It keeps the
 /// selection from moving the same point over and over, the deadlock the paper warns about.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct RecentList {
+pub(crate) struct RecentList {
     items: VecDeque<usize>,
     capacity: usize,
 }
 
 impl RecentList {
     /// An empty list of capacity `capacity` (0 disables it).
-    pub fn new(capacity: usize) -> RecentList {
+    pub(crate) fn new(capacity: usize) -> RecentList {
         RecentList {
             items: VecDeque::with_capacity(capacity),
             capacity,
@@ -170,7 +170,7 @@ impl RecentList {
     }
 
     /// Record a move of control point `j`.
-    pub fn push(&mut self, j: usize) {
+    pub(crate) fn push(&mut self, j: usize) {
         if self.capacity == 0 {
             return;
         }
@@ -181,32 +181,24 @@ impl RecentList {
     }
 
     /// Whether `j` was moved recently.
-    pub fn contains(&self, j: usize) -> bool {
+    pub(crate) fn contains(&self, j: usize) -> bool {
         self.items.contains(&j)
     }
 
     /// Forget every entry.
-    pub fn clear(&mut self) {
+    pub(crate) fn clear(&mut self) {
         self.items.clear();
     }
 
-    /// Number of entries.
-    pub fn len(&self) -> usize {
-        self.items.len()
-    }
-
     /// Whether the list is empty.
-    pub fn is_empty(&self) -> bool {
+    #[cfg(test)]
+    pub(crate) fn is_empty(&self) -> bool {
         self.items.is_empty()
     }
 
-    /// The capacity R.
-    pub fn capacity(&self) -> usize {
-        self.capacity
-    }
-
     /// The entries, oldest first.
-    pub fn iter(&self) -> impl Iterator<Item = usize> + '_ {
+    #[cfg(test)]
+    pub(crate) fn iter(&self) -> impl Iterator<Item = usize> + '_ {
         self.items.iter().copied()
     }
 }
@@ -218,7 +210,7 @@ impl RecentList {
 ///
 /// # Panics
 /// If `movable` is shorter than `deviation`.
-pub fn select_candidate(
+pub(crate) fn select_candidate(
     deviation: &[f64],
     movable: &[bool],
     recent: &mut RecentList,
@@ -252,7 +244,7 @@ pub fn select_candidate(
 /// `κ1,2 = H ± sqrt(max(H² − K, 0))`. Signs follow the orientation of `n`.
 ///
 /// `None` where the surface is singular (`S_u × S_v = 0`, or non-finite input).
-pub fn principal_curvatures(
+pub(crate) fn principal_curvatures(
     su: [f64; 3],
     sv: [f64; 3],
     suu: [f64; 3],
@@ -286,7 +278,7 @@ pub fn principal_curvatures(
 
 /// The result of [`principal_curvatures`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PrincipalCurvatures {
+pub(crate) struct PrincipalCurvatures {
     /// The larger principal curvature κ1.
     pub kappa1: f64,
     /// The smaller principal curvature κ2.

@@ -10,26 +10,55 @@
 //! Adding a method: implement [`FairMethod`] in a file of its own under `fair/`, declare each
 //! of its parameters once as a `Param` constant (`params.rs`: key, kind with default and
 //! range, doc) and list it in [`methods`].
+//!
+//! # What this namespace exports
+//!
+//! The files below are private modules; what is public is re-exported here by name, the names
+//! of one method prefixed with it where they would be ambiguous:
+//!
+//! - the interface: [`fair`], [`fair_with`], [`fair_curve`] (B-spline input), [`fair_space`]
+//!   (space curves, [`SPACE_METHODS`]), [`method`], [`methods`], [`default_method`],
+//!   [`check_options`], [`catalogue`] ([`MethodInfo`], [`ParamInfo`]); [`FairOptions`],
+//!   [`EndFix`]; what comes back: [`Faired`] with its [`FairReport`] ([`FairStatus`],
+//!   [`Move`], [`HistoryRow`], [`SolverInfo`], [`EndChanges`], [`ToleranceSource`]);
+//!   Han et al.'s comparison protocol [`compare`] ([`Comparison`]);
+//! - the methods, one unit struct each, for [`FairMethod::run`] without the registry:
+//!   [`Mst`], [`Han`], [`Kjellander`], [`Poliakoff`], [`Energy`], [`SapidisFarin`],
+//!   [`Cali`], [`Salvi`], [`EckHadenfeld`], [`Kuragano`], [`Band`]. Each method's equations,
+//!   choices and departures from its paper are in `docs/algorithms/` and in its module's
+//!   documentation in the source (`fair/han/mod.rs`, `fair/salvi/mod.rs`, …);
+//! - the methods' own entry points, with typed parameters: the smoothing spline
+//!   [`SmoothingSpline`] ([`Smoothing`], [`SmoothingInfo`]); [`salvi_fair_curve`]
+//!   ([`SalviParams`], [`SalviSmoother`], [`SalviReport`]) and [`eck_hadenfeld_fair_curve`]
+//!   ([`EckHadenfeldParams`], [`LocalReport`]) on a B-spline; [`fair_hermite`],
+//!   [`hermite_step`] ([`KpRule`], [`HermiteMove`]), [`energy_change_f`] and
+//!   [`parametric_energy`] on Hermite data; [`remove_reinsert_knot`] (Sapidis–Farin);
+//! - two building blocks, for measurements: [`HanSegment`], `han` on one function segment
+//!   ([`HanSegmentParams`], its moves [`HanCaseMove`]), and [`LocalIndicators`], Calì's
+//!   local fairness indicators with their local updates ([`IndicatorTrial`]);
+//! - the documented bounds and factors the methods use ([`MAX_ITERATIONS`],
+//!   [`AUTO_TOLERANCE_K`], [`SALVI_MAX_SAMPLES`], [`BISECTION_REL_PRECISION`], …).
 
-pub mod band;
-pub mod cali;
+mod band;
+mod cali;
 mod catalogue;
 mod clean;
 mod compare;
-pub mod eck_hadenfeld;
+mod eck_hadenfeld;
 mod engine;
 mod guard;
-pub mod han;
-pub mod kjellander;
-pub mod kuragano;
-pub mod local;
+mod han;
+mod kjellander;
+mod kuragano;
+// The local-move helpers the surface methods share with `salvi` and `eck-hadenfeld`.
+pub(crate) mod local;
 mod options;
 mod params;
 mod periodic;
 mod report;
-pub mod salvi;
-pub mod sapidis_farin;
-pub mod smoothing;
+mod salvi;
+mod sapidis_farin;
+mod smoothing;
 mod smoothing_mst;
 mod smoothing_system;
 mod smoothing_trial;
@@ -38,24 +67,35 @@ mod space;
 use std::time::Instant;
 
 pub use band::{Band, auto_k as band_tolerance_factor};
-pub use cali::Cali;
+pub use cali::{Cali, LocalIndicators, Trial as IndicatorTrial};
 pub use catalogue::{MethodInfo, ParamInfo, catalogue};
 pub use clean::LOCAL_CHECK_HALF_WIDTH;
 pub use compare::{Comparison, ComparisonOutcome, ComparisonRow, compare};
-pub use eck_hadenfeld::EckHadenfeld;
+pub use eck_hadenfeld::{EckHadenfeld, EckHadenfeldParams, fair_curve as eck_hadenfeld_fair_curve};
 pub use guard::{CLEAN_SLACK_REL, METHOD_SCALE_RANGE_LOG2};
-pub use han::Han;
-pub use kjellander::{
-    Energy, HermiteMove, Kjellander, KpRule, Poliakoff, fair_hermite, hermite_step,
+pub use han::{
+    CaseMove as HanCaseMove, Han, MoveTag as HanMoveTag, Segment as HanSegment,
+    SegmentParams as HanSegmentParams,
 };
+pub use kjellander::{
+    Energy, HermiteMove, Kjellander, KpRule, Poliakoff, energy_change_f, fair_hermite,
+    hermite_step, parametric_energy,
+};
+pub use kuragano::Kuragano;
+pub use local::LocalReport;
 pub use options::{AUTO_TOLERANCE_K, EndFix, FairOptions, MAX_ITERATIONS};
 pub use params::{ParamDefault, ParamSpec, ParamType};
 pub use report::{
     EndChanges, FairReport, FairStatus, HistoryRow, Move, SolverInfo, ToleranceSource,
 };
-pub use salvi::Salvi;
+pub use salvi::{
+    MAX_SAMPLES as SALVI_MAX_SAMPLES, Salvi, SalviParams, SalviReport, Smoother as SalviSmoother,
+    fair_curve as salvi_fair_curve,
+};
 pub use sapidis_farin::{SapidisFarin, remove_reinsert_knot};
-pub use smoothing::{Mst, Smoothing, SmoothingInfo, SmoothingSpline, SmoothingTrial};
+pub use smoothing::{
+    BISECTION_REL_PRECISION, Mst, Smoothing, SmoothingInfo, SmoothingSpline, SmoothingTrial,
+};
 pub use space::{
     FairedSpace, SPACE_METHODS, SpaceFairReport, SpaceOutcome, check_space_method, fair_space,
 };

@@ -76,7 +76,7 @@ pub(crate) fn interpolate_closed(points: &[Point]) -> Result<(BSplineCurve, Vec<
 
 /// Fewest points of a closed curve for `sapidis-farin`: the support of a basis function
 /// (four spans) must be shorter than the period.
-pub const MIN_CLOSED_POINTS: usize = 6;
+pub(super) const MIN_CLOSED_POINTS: usize = 6;
 
 #[cfg(test)]
 mod tests {

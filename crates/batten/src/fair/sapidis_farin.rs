@@ -96,7 +96,6 @@ use super::engine::{
     EPSILON, JUMP_PARAMS, JUMP_ZERO_REL, LocalProblem, MIN_CHORD_REL, MaxTree, Threshold, drive,
     driven_parameters, max_fraction, move_limit, tolerance_radius,
 };
-pub use super::periodic::MIN_CLOSED_POINTS;
 use super::periodic::{PAD, interpolate_closed, period_index};
 use super::{FairMethod, FairOptions, Outcome, ParamSpec};
 use crate::curve::Curve;
@@ -108,7 +107,7 @@ use crate::spline::{BSplineCurve, MAX_ORDER, Parametrization};
 const DEGREE: usize = 3;
 
 /// Method `sapidis-farin`: fairing a cubic B-spline by removing and reinserting its worst
-/// knot (see the module docs).
+/// knot (see `docs/algorithms/kjellander-poliakoff.md`).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SapidisFarin;
 
@@ -151,7 +150,7 @@ fn farin_point(ctrl: &[Point], u: &[f64], j: usize) -> Point {
 }
 
 /// Remove the simple interior knot `u_j` (knot index `j`) of a non-rational cubic B-spline
-/// and reinsert it (Farin's local formula, see the module docs). The result has the same
+/// and reinsert it (Farin's local formula, see `docs/algorithms/kjellander-poliakoff.md`). The result has the same
 /// knot vector, differs from `curve` in the control point `j − 2` only, and its third
 /// derivative is continuous at `u_j`.
 ///

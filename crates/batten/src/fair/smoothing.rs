@@ -64,7 +64,7 @@
 //! behave the same at every scale.
 
 use super::FairOptions;
-pub use super::smoothing_mst::{Mst, p_at_scale};
+pub use super::smoothing_mst::Mst;
 use super::smoothing_system::Penta;
 pub(crate) use super::smoothing_trial::roughness;
 use super::smoothing_trial::{dot, max_displacement};
@@ -80,7 +80,7 @@ pub const BISECTION_REL_PRECISION: f64 = 1e-3;
 /// Default limit on bisection steps in tolerance mode (`max_iterations` overrides it). The
 /// bracket is about 90 units of `ln α` wide at n = 10⁶, so ~17 steps reach
 /// [`BISECTION_REL_PRECISION`]; the default leaves ample room.
-pub const DEFAULT_MAX_BISECTION_STEPS: usize = 60;
+pub(super) const DEFAULT_MAX_BISECTION_STEPS: usize = 60;
 
 /// The searches start `LOG_ALPHA_BELOW` units of `ln α` below `ln α_ref`. The displacements
 /// `g − y = α W⁻¹ Q γ` vanish linearly with α, so at `α = α_ref·e⁻²⁵ ≈ 1.4·10⁻¹¹ α_ref` they
@@ -127,6 +127,7 @@ pub enum Smoothing {
 
 /// One spline computed during a search (the trace behind [`SmoothingInfo::trials`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct SmoothingTrial {
     /// The smoothing parameter.
     pub p: f64,
@@ -142,6 +143,7 @@ pub struct SmoothingTrial {
 
 /// How p was chosen and what the search saw.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct SmoothingInfo {
     /// The smoothing parameter used.
     pub p: f64,

@@ -27,9 +27,9 @@ pub(crate) const P: Param<Auto<f64>> = Param {
 static PARAMS: &[ParamSpec] = &[P.spec()];
 
 /// The `mst` fairing method: the cubic smoothing spline of the points at chord-length
-/// parameters, with p given (`--set p=…`), chosen for `--tolerance`, or by GCV. See the module
-/// documentation of [`super::smoothing`] for the equations and [`super::SmoothingSpline`] for
-/// the library API.
+/// parameters, with p given (`--set p=…`), chosen for `--tolerance`, or by GCV. See
+/// [`super::SmoothingSpline`] for the library API (the equations are in the source,
+/// `fair/smoothing.rs`).
 ///
 /// Reports `p`, `alpha`, `selection` (`given`, `tolerance`, `gcv`), `roughness` and, for GCV,
 /// `gcv` and `degrees_of_freedom` in [`Outcome::parameters`]; iterations are the splines the
@@ -44,7 +44,7 @@ pub struct Mst;
 /// parameters) are multiplied by `f`: the objective `p·Σ|y − f|² + (1 − p)·∫|f''|² dt`
 /// becomes `p·f²·Σ + (1 − p)/f·∫`, so the ratio `(1 − p)/p` is divided by `f³`. Exact in
 /// real arithmetic; the limits p → 1 (interpolation) and p → 0 (the line) are kept.
-pub fn p_at_scale(p: f64, f: f64) -> f64 {
+pub(super) fn p_at_scale(p: f64, f: f64) -> f64 {
     if p <= 0.0 || p >= 1.0 {
         return p;
     }

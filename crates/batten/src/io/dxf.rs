@@ -57,7 +57,7 @@ pub(crate) struct Found<'a> {
 }
 
 impl Found<'_> {
-    pub fn handle(&self) -> String {
+    pub(super) fn handle(&self) -> String {
         format!("{:X}", self.entity.common.handle.0)
     }
 

@@ -3,8 +3,14 @@
 //! - [`ParametricCubic`]: the C² cubic interpolating spline through planar points;
 //! - [`CubicSplineFn`]: the cubic spline *function* y(x) of HAN (spec §1.2), end conditions
 //!   [`FnEndCondition`];
-//! - [`KnotVector`] and [`BSplineCurve`]: B-spline / NURBS curves of any degree.
+//! - [`KnotVector`] and [`BSplineCurve`]: B-spline / NURBS curves of any degree, with knot
+//!   insertion and removal ([`KnotRemoval`], [`RemovalRule`], [`KnotRef`]);
+//! - [`LambdaOperator`]: the λ-operator of Calì et al.;
+//! - the uniform quintic of Kuragano & Yamaguchi: [`interpolate_quintic`] (ends
+//!   [`QuinticEnds`], end gradients from [`quintic_end_gradients`]),
+//!   [`interpolate_quintic_hermite`], as a B-spline or NURBS ([`QuinticForm`]).
 //!
+//! The files below are private modules; everything public is re-exported here by name.
 //! Nothing here knows about fairing.
 
 mod bspline;
@@ -14,7 +20,8 @@ mod interpolate;
 mod knots;
 mod lambda_operator;
 mod parametric;
-pub mod quintic;
+// The radius-of-curvature analysis samples the quintic in closed form.
+pub(crate) mod quintic;
 
 pub(crate) use bspline::basis_derivs;
 pub use bspline::{BSplineCurve, MAX_ORDER};
@@ -27,4 +34,9 @@ pub use parametric::{EndCondition, ParametricCubic, Parametrization, parameters}
 pub(crate) use parametric::{
     Ends, c2_closed_tangents, c2_tangents, hermite_coeffs, open_tangents, periodic_tangents,
     span_derivatives,
+};
+pub use quintic::{
+    DEFAULT_GRADIENT_FRACTION as QUINTIC_GRADIENT_FRACTION, Ends as QuinticEnds,
+    HermiteSystem as QuinticHermiteSystem, QuinticForm, end_gradients as quintic_end_gradients,
+    interpolate as interpolate_quintic, interpolate_hermite as interpolate_quintic_hermite,
 };

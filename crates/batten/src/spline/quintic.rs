@@ -42,11 +42,11 @@ use crate::geom::{Point, Vec2};
 use crate::numeric::{PIVOT_REL, SymBanded};
 
 /// The degree of the KY curve: quintic (order 6).
-pub const DEGREE: usize = 5;
+pub(crate) const DEGREE: usize = 5;
 
 /// Width of the stencils: the derivatives of orders 0..4 at `t = 0` of a segment involve
 /// `q_i..q_{i+4}` only.
-pub const STENCIL_WIDTH: usize = 5;
+pub(crate) const STENCIL_WIDTH: usize = 5;
 
 /// `d^r R/dt^r` at `t = 0` of segment `i`, as coefficients of `q_i..q_{i+4}`, for r = 0..4
 /// (spec §5.1 table). Row 0 is eq 8, row 1 eq 9, rows 2 and 4 the end conditions.
@@ -55,7 +55,7 @@ pub const STENCIL_WIDTH: usize = 5;
 /// gives `N_1'''(0) = 6·20/120 = 1`, de Boor–Cox agrees, and only this row reproduces cubics
 /// (`q_j = j³` must give `R''' = 6`; the printed row gives 58). Row 3 is not used by any
 /// construction here.
-pub const ROWS: [[f64; STENCIL_WIDTH]; 5] = [
+pub(crate) const ROWS: [[f64; STENCIL_WIDTH]; 5] = [
     [
         1.0 / 120.0,
         26.0 / 120.0,
@@ -84,7 +84,7 @@ const BASIS_COEFFS: [[f64; 6]; 6] = [
 /// second derivatives (eq 4 and its derivative): `out[r][j] = d^r N_j/dt^r`, j = 0..5 for the
 /// control points `q_i..q_{i+5}` of segment i. Closed form, no allocation: the fast path of
 /// the KY shape modification.
-pub fn basis(t: f64) -> [[f64; 6]; 3] {
+pub(crate) fn basis(t: f64) -> [[f64; 6]; 3] {
     let mut out = [[0.0; 6]; 3];
     for (j, c) in BASIS_COEFFS.iter().enumerate() {
         let (mut v, mut d1, mut d2) = (0.0, 0.0, 0.0);
@@ -107,7 +107,7 @@ pub fn basis(t: f64) -> [[f64; 6]; 3] {
 /// Segment `i` in power form: `R(t) = Σ_e c_e t^e` (e = 0..5, local `t ∈ [0, 1]`) for its six
 /// control points `q_i..q_{i+5}` (eq 3 expanded). Derivatives follow by differentiating the
 /// polynomial, which is how the KY shape modification evaluates speed cheaply.
-pub fn power_form(q: [Point; 6]) -> [Vec2; 6] {
+pub(crate) fn power_form(q: [Point; 6]) -> [Vec2; 6] {
     let mut c = [Vec2::ZERO; 6];
     for (e, ce) in c.iter_mut().enumerate() {
         for (j, qj) in q.iter().enumerate() {
@@ -122,7 +122,7 @@ pub fn power_form(q: [Point; 6]) -> [Vec2; 6] {
 pub const DEFAULT_GRADIENT_FRACTION: f64 = 1.0 / 3.0;
 
 /// Fewest points an interpolant can have: two points give one segment (six control points).
-pub const MIN_POINTS: usize = 2;
+pub(crate) const MIN_POINTS: usize = 2;
 
 /// Largest width (in columns) a row may reach during the banded elimination. Every row ends
 /// at most five columns after its first one, and at column c every active row started at or
@@ -166,7 +166,7 @@ pub enum HermiteSystem {
 ///
 /// # Errors
 /// [`Error::TooFewPoints`] for fewer than six control points.
-pub fn uniform_knots(n_ctrl: usize) -> Result<KnotVector> {
+pub(crate) fn uniform_knots(n_ctrl: usize) -> Result<KnotVector> {
     if n_ctrl < DEGREE + 1 {
         return Err(Error::TooFewPoints {
             needed: DEGREE + 1,
@@ -184,7 +184,10 @@ pub fn uniform_knots(n_ctrl: usize) -> Result<KnotVector> {
 ///
 /// # Errors
 /// [`Error::TooFewPoints`] for fewer than six control points, [`Error::NonFinite`].
-pub fn from_control_points(control_points: Vec<Point>, form: QuinticForm) -> Result<BSplineCurve> {
+pub(crate) fn from_control_points(
+    control_points: Vec<Point>,
+    form: QuinticForm,
+) -> Result<BSplineCurve> {
     let n = control_points.len();
     let knots = uniform_knots(n)?;
     let weights = match form {
@@ -196,7 +199,7 @@ pub fn from_control_points(control_points: Vec<Point>, form: QuinticForm) -> Res
 
 /// True when `curve` is a quintic on uniform unit-spaced knots starting at −5 with all weights
 /// equal (absent or all one): the form this module builds.
-pub fn is_uniform_quintic(curve: &BSplineCurve) -> bool {
+pub(crate) fn is_uniform_quintic(curve: &BSplineCurve) -> bool {
     curve.degree() == DEGREE
         && curve
             .knots()
@@ -708,5 +711,179 @@ mod tests {
             interpolate(&arc(5), &Ends::Natural, QuinticForm::Nurbs).expect("test data is valid");
         assert_eq!(c.weights(), Some(&[1.0; 9][..]));
         assert!(is_uniform_quintic(&c));
+    }
+
+    /// The "kuragano" vectors of `tests/data/test-vectors.json` on the quintic's basis and
+    /// interpolation (moved here from `tests/kuragano.rs`: they check `ROWS` and `basis`,
+    /// which are not public).
+    mod vectors {
+        use serde_json::Value;
+
+        use super::super::*;
+        use crate::curve::{Curve, CurveDeriv};
+
+        fn vector(id: &str) -> Value {
+            let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/test-vectors.json");
+            let text = std::fs::read_to_string(path).expect("test vectors");
+            let all: Value = serde_json::from_str(&text).expect("valid JSON");
+            all["kuragano"]
+                .as_array()
+                .expect("kuragano vectors")
+                .iter()
+                .find(|v| v["id"] == id)
+                .unwrap_or_else(|| panic!("vector {id}"))
+                .clone()
+        }
+
+        fn num(v: &Value) -> f64 {
+            v.as_f64().expect("number")
+        }
+
+        fn nums(v: &Value) -> Vec<f64> {
+            v.as_array().expect("array").iter().map(num).collect()
+        }
+
+        fn points(v: &Value) -> Vec<Point> {
+            v.as_array()
+                .expect("point list")
+                .iter()
+                .map(|p| Point::new(num(&p[0]), num(&p[1])))
+                .collect()
+        }
+
+        /// The spec §7 check `|got − exp| ≤ abs + rel·|exp|`.
+        fn close(got: f64, exp: f64, tol: &Value, what: &str) {
+            let (abs, rel) = (num(&tol["abs"]), num(&tol["rel"]));
+            assert!(
+                (got - exp).abs() <= abs + rel * exp.abs(),
+                "{what}: got {got:e}, expected {exp:e}"
+            );
+        }
+
+        /// A curve with six control points on the knots −5..6: its only segment is the paper's eq 3.
+        fn one_segment() -> BSplineCurve {
+            let q = (0..6)
+                .map(|i| Point::new(i as f64, (i * i) as f64))
+                .collect();
+            from_control_points(q, QuinticForm::BSpline).expect("curve")
+        }
+
+        #[test]
+        fn ky_basis_rows_follow_from_the_basis() {
+            let v = vector("ky.basis.rows");
+            let tol = &v["tolerance"];
+            let c = one_segment();
+            let mut b = [[0.0; crate::spline::MAX_ORDER]; 4];
+            c.basis_derivs(c.find_span(0.0), 0.0, 3, &mut b);
+            // r = 4: N''' of a segment is a quadratic in t, so its derivative at 0 is exactly
+            // (−3 f(0) + 4 f(h) − f(2h)) / 2h (up to rounding).
+            let h = 0.25;
+            let third = |t: f64| {
+                let mut o = [[0.0; crate::spline::MAX_ORDER]; 4];
+                c.basis_derivs(c.find_span(t), t, 3, &mut o);
+                o[3]
+            };
+            let (f0, f1, f2) = (third(0.0), third(h), third(2.0 * h));
+            let derived: Vec<Vec<f64>> = (0..=4)
+                .map(|r| {
+                    (0..6)
+                        .map(|j| {
+                            if r <= 3 {
+                                b[r][j]
+                            } else {
+                                (-3.0 * f0[j] + 4.0 * f1[j] - f2[j]) / (2.0 * h)
+                            }
+                        })
+                        .collect()
+                })
+                .collect();
+            for (r, row) in derived.iter().enumerate() {
+                // The coefficient of q_{i+5} is zero for r ≤ 4.
+                assert!(row[5].abs() < 1e-12, "r={r}");
+                // The named stencils agree with de Boor–Cox (Piegl & Tiller A2.3).
+                let t = if r <= 3 { 1e-15 } else { 1e-12 };
+                for j in 0..5 {
+                    assert!((row[j] - ROWS[r][j]).abs() < t, "r={r} j={j}");
+                }
+                // Polynomial reproduction: for q_j = j^k the curve is a degree-k polynomial in u with
+                // leading coefficient 1, so d^r R/du^r = r! when k = r and 0 when k < r.
+                for k in 0..=r {
+                    let moment: f64 = (0..5).map(|j| ROWS[r][j] * (j as f64).powi(k as i32)).sum();
+                    let expected = if k == r {
+                        (1..=r).product::<usize>() as f64
+                    } else {
+                        0.0
+                    };
+                    assert!((moment - expected).abs() < 1e-12, "r={r} k={k}: {moment}");
+                }
+            }
+            // The vector: rows 0, 1 (eq 8, eq 9), 2 and 4 as given.
+            for r in [0, 1, 2, 4] {
+                for (j, &e) in nums(&v["expected"][format!("r{r}")]).iter().enumerate() {
+                    close(ROWS[r][j], e, tol, &format!("ROWS[{r}][{j}]"));
+                }
+            }
+            // Row 3 of the vector (and of the spec table) has the signs of q_{i+1} and q_{i+3}
+            // swapped: it fails the reproduction test above (q_j = j³ gives 58, not 6), so the
+            // derived row is asserted and the vector's row only up to those two signs.
+            let r3 = nums(&v["expected"]["r3"]);
+            for (j, &e) in r3.iter().enumerate() {
+                let sign = if j == 1 || j == 3 { -1.0 } else { 1.0 };
+                close(ROWS[3][j], sign * e, tol, &format!("ROWS[3][{j}]"));
+            }
+        }
+
+        #[test]
+        fn ky_basis_values_t0_3() {
+            let v = vector("ky.basis.values_t0_3");
+            let tol = &v["tolerance"];
+            let t = num(&v["inputs"]["t"]);
+            let c = one_segment();
+            let mut b = [[0.0; crate::spline::MAX_ORDER]; 4];
+            c.basis_derivs(c.find_span(t), t, 2, &mut b);
+            let closed_form = basis(t);
+            for (r, key) in ["N", "dN", "d2N"].iter().enumerate() {
+                for (j, &e) in nums(&v["expected"][*key]).iter().enumerate() {
+                    close(b[r][j], e, tol, &format!("basis_derivs {key}[{j}]"));
+                    close(
+                        closed_form[r][j],
+                        e,
+                        tol,
+                        &format!("quintic::basis {key}[{j}]"),
+                    );
+                }
+            }
+        }
+
+        #[test]
+        fn ky_interpolate_natural_ends() {
+            let v = vector("ky.interpolate.natural_ends");
+            let tol = &v["tolerance"];
+            let pts = points(&v["inputs"]["points"]);
+            let c = interpolate(&pts, &Ends::Natural, QuinticForm::Nurbs).expect("interpolant");
+            let exp = points(&v["expected"]["control_points"]);
+            assert_eq!(c.control_points().len(), exp.len());
+            for (j, (q, e)) in c.control_points().iter().zip(&exp).enumerate() {
+                close(q.x, e.x, tol, &format!("q[{j}].x"));
+                close(q.y, e.y, tol, &format!("q[{j}].y"));
+            }
+            // NURBS form with unit weights; passes through the points at u = i.
+            assert!(c.weights().is_some_and(|w| w.iter().all(|&x| x == 1.0)));
+            for (i, p) in pts.iter().enumerate() {
+                assert!((c.eval(i as f64) - *p).length() < 1e-12);
+            }
+            // R'' = 0 and R'''' = 0 at both ends (rows 2 and 4 on q_0..q_4 and q_{m−1}..q_{m+3}).
+            let q = c.control_points();
+            let m = pts.len();
+            for start in [0, m - 1] {
+                for r in [2, 4] {
+                    let v: Vec2 =
+                        (0..5).fold(Vec2::ZERO, |a, k| a + q[start + k].to_vec2() * ROWS[r][k]);
+                    assert!(v.length() < 1e-12, "row {r} at {start}");
+                }
+            }
+            assert!(c.derivatives(0.0).d2.length() < 1e-12);
+            assert!(c.derivatives((m - 1) as f64).d2.length() < 1e-12);
+        }
     }
 }

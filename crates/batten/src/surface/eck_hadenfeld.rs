@@ -35,10 +35,10 @@ use crate::fair::FairStatus;
 use crate::fair::local::{DEFAULT_TABU_LENGTH, RecentList, clamp_to_original, select_candidate};
 
 /// Default move budget.
-pub const DEFAULT_MAX_ITERATIONS: usize = 2000;
+pub(super) const DEFAULT_MAX_ITERATIONS: usize = 2000;
 
 /// Stop when the best move lowers the energy by less than this fraction of it.
-pub const MIN_REL_DECREASE: f64 = 1e-9;
+pub(super) const MIN_REL_DECREASE: f64 = 1e-9;
 
 /// The 1-D Gram matrices of a surface, in u and v.
 struct Grams {
@@ -108,7 +108,7 @@ impl Grams {
 /// The thin-plate energy `∬ |S_uu|² + 2|S_uv|² + |S_vv|² du dv` of the polynomial surface
 /// with the control points of `s` (for a rational surface, of its control net taken as a
 /// polynomial surface).
-pub fn thin_plate_energy(s: &BSplineSurface) -> f64 {
+pub(super) fn thin_plate_energy(s: &BSplineSurface) -> f64 {
     Grams::of(s).energy(s.control_points())
 }
 

@@ -34,9 +34,9 @@ pub const DEVIATION_MIN_SAMPLES: usize = 51;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SurfaceMethod {
-    /// Salvi & Várady's target-curvature fairing ([`super::salvi`]).
+    /// Salvi & Várady's target-curvature fairing (`surface/salvi.rs`).
     Salvi,
-    /// Eck & Hadenfeld's local thin-plate energy fairing ([`super::eck_hadenfeld`]).
+    /// Eck & Hadenfeld's local thin-plate energy fairing (`surface/eck_hadenfeld.rs`).
     EckHadenfeld,
 }
 
@@ -116,7 +116,7 @@ pub struct SurfaceFairOptions {
     /// Default value: [`SurfaceMethod::Salvi`].
     pub method: SurfaceMethod,
     /// The hard bound δ on `|S_faired(u, v) − S(u, v)|`; `None` for
-    /// [`DEFAULT_TOLERANCE_REL`] × the diagonal of the control net's bounding box.
+    /// 1 % of the diagonal of the control net's bounding box.
     ///
     /// Default value: `None`.
     pub tolerance: Option<f64>,
@@ -269,7 +269,7 @@ pub(crate) struct Common {
 /// overlaps those of `(2p + 1)(2q + 1) − 1` neighbours: the few points around the worst
 /// defect take turns for ever while their neighbours, which would have to move with them,
 /// never get chosen.
-pub fn tabu_length(degree: (usize, usize)) -> usize {
+pub(super) fn tabu_length(degree: (usize, usize)) -> usize {
     ((degree.0 + 1) * (degree.1 + 1)).max(DEFAULT_TABU_LENGTH)
 }
 
@@ -298,6 +298,7 @@ pub(crate) struct Problem<'a> {
 
 /// Measurements of one surface.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct SurfaceMeasures {
     /// Π̂ (eq 15) on the `salvi` sample grid with the targets of the *input* surface.
     pub pi_hat: f64,

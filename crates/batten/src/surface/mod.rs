@@ -9,19 +9,19 @@
 //!   documented grid of [`SampleGrid::for_surface`]; [`Targets`]: the smooth target
 //!   curvatures g1, g2 of Salvi & Várady (eqs 16–17).
 //! - [`fair_surface`]: fairing within a hard tolerance on `|S_faired(u, v) − S(u, v)|`, by
-//!   [`salvi`] (target principal curvatures, one control point at a time by 3-D
-//!   Nelder–Mead) or [`eck_hadenfeld`] (the closed-form local minimiser of the thin-plate
-//!   energy), with the boundary rows optionally held ([`BoundaryFix`]).
+//!   [`SurfaceMethod::Salvi`] (target principal curvatures, one control point at a time by
+//!   3-D Nelder–Mead) or [`SurfaceMethod::EckHadenfeld`] (the closed-form local minimiser of
+//!   the thin-plate energy), with the boundary rows optionally held ([`BoundaryFix`]).
 //! - [`render`]: pictures for interrogation — curvature colour maps, isophotes, zebra
 //!   stripes and the deviation between two surfaces — rasterised from a [`SurfaceMesh`] in an
 //!   orthographic [`Camera`] view into an RGBA [`Raster`].
 
-pub mod eck_hadenfeld;
+mod eck_hadenfeld;
 mod fairing;
 mod fit;
 mod patch;
 mod render;
-pub mod salvi;
+mod salvi;
 mod sample;
 mod target;
 

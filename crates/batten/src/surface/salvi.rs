@@ -42,31 +42,31 @@ use crate::fair::local::{RecentList, clamp_to_original, select_candidate, suppor
 use crate::numeric::{NelderMeadParams, minimize_nelder_mead};
 
 /// Default move budget.
-pub const DEFAULT_MAX_ITERATIONS: usize = 600;
+pub(super) const DEFAULT_MAX_ITERATIONS: usize = 600;
 
 /// The run stops when a window of moves lowers Π̂ by less than this fraction of its value.
-pub const STALL_REL_IMPROVEMENT: f64 = 1e-3;
+pub(super) const STALL_REL_IMPROVEMENT: f64 = 1e-3;
 
 /// Curvature residuals below this fraction of the largest |κ| on the grid are rounding
 /// error of the target fit (its solve loses a few digits): a run whose Π̂ is below
 /// `N · (PI_HAT_FLOOR_REL · max |κ|)²` (N regular samples) has nothing to fair and stops, so a
 /// sphere or a plane comes back bit for bit.
-pub const PI_HAT_FLOOR_REL: f64 = 1e-6;
+pub(super) const PI_HAT_FLOOR_REL: f64 = 1e-6;
 
 /// Initial simplex edge as a fraction of the mean distance to the neighbouring control
 /// points.
-pub const SIMPLEX_STEP_REL: f64 = 0.1;
+pub(super) const SIMPLEX_STEP_REL: f64 = 0.1;
 
 /// Default Nelder–Mead evaluation budget per move.
-pub const DEFAULT_SIMPLEX_EVALUATIONS: usize = 120;
+pub(super) const DEFAULT_SIMPLEX_EVALUATIONS: usize = 120;
 
 /// Nelder–Mead stops when the simplex is smaller than this fraction of its first edge.
-pub const SIMPLEX_XATOL_REL: f64 = 1e-4;
+pub(super) const SIMPLEX_XATOL_REL: f64 = 1e-4;
 
 /// Parameters of the surface `salvi` method.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
-pub struct SalviSurfaceParams {
+pub(crate) struct SalviSurfaceParams {
     /// Grid samples per knot span and direction.
     ///
     /// Default value: [`SAMPLES_PER_SPAN`].
@@ -83,7 +83,7 @@ pub struct SalviSurfaceParams {
 
 impl SalviSurfaceParams {
     /// The defaults written on the fields.
-    pub const DEFAULT: SalviSurfaceParams = SalviSurfaceParams {
+    pub(crate) const DEFAULT: SalviSurfaceParams = SalviSurfaceParams {
         samples_per_span: SAMPLES_PER_SPAN,
         targets: TargetParams::DEFAULT,
         simplex_evaluations: DEFAULT_SIMPLEX_EVALUATIONS,

@@ -26,16 +26,17 @@ use crate::spline::quintic::{self, Ends, QuinticForm};
 /// for degree 2, 0.999800 for degree 6). The paper's own choices in Table 2 (six, 0.99993
 /// against 0.99981 for quintic) and Table 4 (curves A, E, F, H) are kept; its curve B
 /// (quintic 1.56° against quartic 1.58°, cosines 10⁻⁵ apart) would be quartic.
-/// [`select_best_within`] with [`PAPER_TIE_TOLERANCE`] reproduces the paper's choices.
+/// A tie tolerance of 10⁻⁶ reproduces the paper's choices.
 pub const TIE_TOLERANCE: f64 = 1e-4;
 
 /// The tie tolerance that reproduces every choice of the paper's Table 4 (curve B
 /// included): two cosines near 1.5° that print as angles 0.02° apart differ by about 10⁻⁵.
-pub const PAPER_TIE_TOLERANCE: f64 = 1e-6;
+#[cfg(test)]
+pub(super) const PAPER_TIE_TOLERANCE: f64 = 1e-6;
 
 /// The cosine of two sample vectors, not mean-centred (spec §5.6 step 2); `None` when either
 /// is zero.
-pub fn cosine(a: &[f64], b: &[f64]) -> Option<f64> {
+pub(super) fn cosine(a: &[f64], b: &[f64]) -> Option<f64> {
     let dot: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
     let na = a.iter().map(|x| x * x).sum::<f64>().sqrt();
     let nb = b.iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -65,8 +66,8 @@ pub fn truncate_angle(deg: f64, decimals: u32) -> f64 {
 pub enum Design<'a> {
     /// A point sequence; the design is its uniform quintic interpolant.
     Points(&'a [Point]),
-    /// A non-rational B-spline (any degree and knots; the quintic of
-    /// [`crate::spline::quintic`] in the paper).
+    /// A non-rational B-spline (any degree and knots; in the paper the uniform quintic of
+    /// [`crate::spline::interpolate_quintic`]).
     Curve(&'a BSplineCurve),
 }
 
@@ -90,6 +91,7 @@ impl<'a> From<&'a BSplineCurve> for Design<'a> {
 
 /// One row of the evaluation (a row of the paper's Tables 3 and 4).
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct DegreeResult {
     /// The polynomial degree d.
     pub degree: usize,
@@ -112,6 +114,7 @@ pub struct DegreeResult {
 /// `{"degrees": [{"degree", "applicable", "correlation", "angle_deg"}, ...],
 /// "best_degree", "fairness"}`, with `null` where a value does not exist.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct Evaluation {
     /// Degrees 1..=6 in order.
     pub degrees: Vec<DegreeResult>,
@@ -122,15 +125,45 @@ pub struct Evaluation {
     pub fairness: Option<f64>,
 }
 
+impl DegreeResult {
+    /// A row as the paper's tables print it, from its degree and cosine: applicable, with the
+    /// angle of `correlation`, when there is one, not applicable otherwise; the figures of the
+    /// shape modification (`s_final`, `rho_rms`) are absent.
+    pub fn from_correlation(degree: usize, correlation: Option<f64>) -> DegreeResult {
+        DegreeResult {
+            degree,
+            applicable: correlation.is_some(),
+            correlation,
+            angle_deg: correlation.map(angle_degrees),
+            s_final: None,
+            rho_rms: None,
+        }
+    }
+}
+
+impl Evaluation {
+    /// The evaluation made of `degrees`, with the best degree chosen as [`evaluate`] chooses it
+    /// (the largest cosine, ties within [`TIE_TOLERANCE`] to the lowest degree) and its cosine
+    /// as the fairness.
+    pub fn from_rows(degrees: Vec<DegreeResult>) -> Evaluation {
+        let best = select_best(&degrees);
+        Evaluation {
+            best_degree: best.map(|d| d.degree),
+            fairness: best.and_then(|d| d.correlation),
+            degrees,
+        }
+    }
+}
+
 /// The selected row (spec §5.6 step 4): the applicable row with the largest correlation, where
 /// correlations within [`TIE_TOLERANCE`] of the largest tie and the lowest degree wins.
 /// `None` when no row has a correlation.
-pub fn select_best(rows: &[DegreeResult]) -> Option<&DegreeResult> {
+pub(super) fn select_best(rows: &[DegreeResult]) -> Option<&DegreeResult> {
     select_best_within(rows, TIE_TOLERANCE)
 }
 
 /// [`select_best`] with ties within `tie` (e.g. [`PAPER_TIE_TOLERANCE`]).
-pub fn select_best_within(rows: &[DegreeResult], tie: f64) -> Option<&DegreeResult> {
+pub(super) fn select_best_within(rows: &[DegreeResult], tie: f64) -> Option<&DegreeResult> {
     let best = rows
         .iter()
         .filter(|d| d.applicable)
@@ -263,7 +296,7 @@ pub(crate) fn evaluate_detailed(
 ///
 /// ```
 /// use batten::Point;
-/// use batten::analysis::roc_fairness::{KuraganoOptions, evaluate};
+/// use batten::analysis::{KuraganoOptions, evaluate_roc_fairness};
 ///
 /// // A spiral arc: ρ grows with the arc length, no inflection.
 /// let pts: Vec<Point> = (0..16)
@@ -273,12 +306,12 @@ pub(crate) fn evaluate_detailed(
 ///         Point::new(r * a.cos(), r * a.sin())
 ///     })
 ///     .collect();
-/// let e = evaluate(&pts, &KuraganoOptions::default())?;
+/// let e = evaluate_roc_fairness(&pts, &KuraganoOptions::default())?;
 /// assert_eq!(e.degrees.len(), 6);
 /// assert!(e.best_degree.is_some() && e.fairness.is_some_and(|c| c > 0.99));
 /// // An S-shaped design has no applicable degree.
 /// let s: Vec<Point> = (0..16).map(|i| Point::new(i as f64, (0.4 * i as f64).sin())).collect();
-/// assert_eq!(evaluate(&s, &KuraganoOptions::default())?.best_degree, None);
+/// assert_eq!(evaluate_roc_fairness(&s, &KuraganoOptions::default())?.best_degree, None);
 /// # Ok::<(), batten::Error>(())
 /// ```
 ///

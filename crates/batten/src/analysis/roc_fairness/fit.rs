@@ -5,15 +5,15 @@
 use crate::error::{Error, Result};
 
 /// Lowest polynomial degree of the specification (linear).
-pub const MIN_DEGREE: usize = 1;
+pub(crate) const MIN_DEGREE: usize = 1;
 
 /// Highest polynomial degree of the specification ("six degrees", paper §5).
-pub const MAX_DEGREE: usize = 6;
+pub(crate) const MAX_DEGREE: usize = 6;
 
 /// A least-squares polynomial `ρ̂(s)` of degree d on [0, 1] (spec §5.4 step 3), held in the
 /// Chebyshev basis `T_k(2s − 1)`.
 #[derive(Clone, Debug, PartialEq)]
-pub struct RhoFit {
+pub(crate) struct RhoFit {
     degree: usize,
     chebyshev: Vec<f64>,
 }
@@ -25,7 +25,7 @@ impl RhoFit {
     /// [`Error::InvalidParameter`] for a degree outside 1..=6, [`Error::LengthMismatch`],
     /// [`Error::TooFewPoints`] for fewer than `degree + 1` samples, [`Error::NonFinite`],
     /// [`Error::Singular`].
-    pub fn fit(s: &[f64], rho: &[f64], degree: usize) -> Result<RhoFit> {
+    pub(crate) fn fit(s: &[f64], rho: &[f64], degree: usize) -> Result<RhoFit> {
         if !(MIN_DEGREE..=MAX_DEGREE).contains(&degree) {
             return Err(Error::InvalidParameter {
                 name: "degree".into(),
@@ -65,18 +65,19 @@ impl RhoFit {
     }
 
     /// The degree d.
-    pub fn degree(&self) -> usize {
+    pub(crate) fn degree(&self) -> usize {
         self.degree
     }
 
     /// `ρ̂(s)`.
-    pub fn eval(&self, s: f64) -> f64 {
+    pub(crate) fn eval(&self, s: f64) -> f64 {
         let t = chebyshev_values(2.0 * s - 1.0, self.degree);
         self.chebyshev.iter().zip(&t).map(|(c, t)| c * t).sum()
     }
 
     /// The coefficients `c_0..c_d` of `ρ̂(s) = Σ c_e s^e` (monomial basis in s).
-    pub fn coefficients_ascending(&self) -> Vec<f64> {
+    #[cfg(test)]
+    pub(crate) fn coefficients_ascending(&self) -> Vec<f64> {
         // T_k(2s − 1) as polynomials in s, by the recurrence T_{k+1} = 2x T_k − T_{k−1}.
         let d = self.degree;
         let mut out = vec![0.0; d + 1];
@@ -102,7 +103,7 @@ impl RhoFit {
     }
 
     /// `ρ̂(s_i)` for every `s_i`.
-    pub fn eval_all(&self, s: &[f64]) -> Vec<f64> {
+    pub(crate) fn eval_all(&self, s: &[f64]) -> Vec<f64> {
         s.iter().map(|&x| self.eval(x)).collect()
     }
 }

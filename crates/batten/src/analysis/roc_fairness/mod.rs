@@ -106,19 +106,17 @@ mod layout;
 mod modify;
 mod options;
 mod samples;
+#[cfg(test)]
+mod tests;
 
 pub use evaluate::{
-    DegreeResult, Design, Evaluation, PAPER_TIE_TOLERANCE, TIE_TOLERANCE, angle_degrees, cosine,
-    evaluate, select_best, select_best_within, truncate_angle,
+    DegreeResult, Design, Evaluation, TIE_TOLERANCE, angle_degrees, evaluate, truncate_angle,
 };
 pub(crate) use evaluate::{design_curve, design_samples, evaluate_detailed, fits};
-pub use fit::{MAX_DEGREE, MIN_DEGREE, RhoFit};
-pub use modify::{
-    DEFAULT_MAX_ITERATIONS, DIAG_FLOOR_REL, MU_FACTOR, MU_INITIAL, MU_MAX, Modification,
-    ModificationStep, ShapeConstraints, StopReason, modify_shape, rho_gradient,
+pub(crate) use fit::{MAX_DEGREE, MIN_DEGREE, RhoFit};
+pub(crate) use modify::{
+    DEFAULT_MAX_ITERATIONS, Modification, ShapeConstraints, StopReason, modify_shape,
 };
 pub use options::{DEFAULT_METHOD_GRADIENT_FRACTION, DesignEnds, KuraganoOptions, Residual};
-pub use samples::{
-    DEFAULT_RHO_MAX_REL, DEFAULT_SAMPLES, MAX_SAMPLES, MIN_SAMPLES, RhoSamples,
-    SAMPLES_PER_SEGMENT, default_samples, sample_rho,
-};
+pub use samples::MAX_SAMPLES;
+pub(crate) use samples::{MIN_SAMPLES, RhoSamples};

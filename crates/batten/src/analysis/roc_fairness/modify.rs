@@ -9,26 +9,26 @@ use super::options::Residual;
 use super::samples::{Evaluator, RhoSamples, check_polynomial, sample_at_fractions};
 use crate::curve::Curve;
 use crate::error::{Error, Result};
-use crate::geom::{Point, Vec2};
+use crate::geom::Point;
 use crate::numeric::SymBanded;
 use crate::spline::{BSplineCurve, MAX_ORDER};
 
 /// Initial Levenberg–Marquardt damping (spec §5.5).
-pub const MU_INITIAL: f64 = 1e-3;
+pub(super) const MU_INITIAL: f64 = 1e-3;
 
 /// Factor by which μ is divided after an accepted step and multiplied after a rejected one
 /// (spec §5.5).
-pub const MU_FACTOR: f64 = 10.0;
+pub(super) const MU_FACTOR: f64 = 10.0;
 
 /// Damping beyond which no step is deemed acceptable and the iteration stops: the step is
 /// then shorter than rounding of the control points.
-pub const MU_MAX: f64 = 1e12;
+pub(super) const MU_MAX: f64 = 1e12;
 
 /// Default cap on linearisations of the shape modification (the test vectors' 60).
-pub const DEFAULT_MAX_ITERATIONS: usize = 60;
+pub(crate) const DEFAULT_MAX_ITERATIONS: usize = 60;
 
 /// Floor of the Marquardt scaling `diag(JᵀJ)`, relative to its largest entry.
-pub const DIAG_FLOOR_REL: f64 = 1e-12;
+pub(super) const DIAG_FLOOR_REL: f64 = 1e-12;
 
 /// ρ at parameter `u` of a non-rational B-spline and its gradient with respect to the control
 /// points of the span, holding `u` fixed (spec §5.5):
@@ -44,7 +44,11 @@ pub const DIAG_FLOOR_REL: f64 = 1e-12;
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for a rational curve with unequal weights.
-pub fn rho_gradient(curve: &BSplineCurve, u: f64) -> Result<(f64, usize, Vec<Vec2>)> {
+#[cfg(test)]
+pub(super) fn rho_gradient(
+    curve: &BSplineCurve,
+    u: f64,
+) -> Result<(f64, usize, Vec<crate::geom::Vec2>)> {
     check_polynomial(curve)?;
     let local = Evaluator::new(curve).local(u);
     let rho = 1.0 / local.kappa;
@@ -58,7 +62,7 @@ pub fn rho_gradient(curve: &BSplineCurve, u: f64) -> Result<(f64, usize, Vec<Vec
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 #[non_exhaustive]
-pub enum StopReason {
+pub(crate) enum StopReason {
     /// No step decreased S (μ grew beyond [`MU_MAX`]): converged as far as LM can tell.
     NoAcceptableStep,
     /// The iteration cap was reached.
@@ -71,7 +75,7 @@ pub enum StopReason {
 
 /// Constraints of [`modify_shape`] beyond the fixed `q_0` and `q_{n−1}`.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct ShapeConstraints<'a> {
+pub(crate) struct ShapeConstraints<'a> {
     /// Output points to watch: `(parameters u_k, original points P_k)`. The history records
     /// the largest `|C(u_k) − P_k|` after every accepted step.
     pub anchors: Option<(&'a [f64], &'a [Point])>,
@@ -101,7 +105,7 @@ impl ShapeConstraints<'_> {
 
 /// One accepted step of [`modify_shape`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ModificationStep {
+pub(crate) struct ModificationStep {
     /// S after the step.
     pub s: f64,
     /// The largest anchor distance after the step (`None` without anchors).
@@ -110,7 +114,7 @@ pub struct ModificationStep {
 
 /// The result of [`modify_shape`].
 #[derive(Clone, Debug)]
-pub struct Modification {
+pub(crate) struct Modification {
     /// The modified curve.
     pub curve: BSplineCurve,
     /// Its ρ samples at the same fractions (capped with the target's ρ_max and orientation).
@@ -193,7 +197,7 @@ fn resample(curve: &BSplineCurve, like: &RhoSamples) -> Result<RhoSamples> {
 /// move, and [`Error::Degenerate`] when the curve collapses.
 ///
 /// [`sample_rho`]: super::sample_rho
-pub fn modify_shape(
+pub(crate) fn modify_shape(
     curve: &BSplineCurve,
     start: &RhoSamples,
     target: &[f64],

@@ -50,17 +50,16 @@ pub enum DesignEnds {
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct KuraganoOptions {
-    /// Number of ρ samples `N_s`, in [`MIN_SAMPLES`]`..=`[`MAX_SAMPLES`]; `None`: [`default_samples`].
+    /// Number of ρ samples `N_s`, in `7..=`[`ROC_MAX_SAMPLES`]; `None`:
+    /// `max(41, 10·segments + 1)` for a curve of that many spans.
     ///
     /// Default value: `None`.
     ///
-    /// [`default_samples`]: super::default_samples
+    /// [`ROC_MAX_SAMPLES`]: crate::analysis::ROC_MAX_SAMPLES
     pub samples: Option<usize>,
-    /// The cap `ρ_max` in data units; `None`: [`DEFAULT_RHO_MAX_REL`] times the arc length.
+    /// The cap `ρ_max` in data units; `None`: 100 times the arc length.
     ///
     /// Default value: `None`.
-    ///
-    /// [`DEFAULT_RHO_MAX_REL`]: super::DEFAULT_RHO_MAX_REL
     pub rho_max: Option<f64>,
     /// The residual of the shape modification.
     ///
@@ -68,7 +67,7 @@ pub struct KuraganoOptions {
     pub residual: Residual,
     /// Cap on Levenberg–Marquardt linearisations.
     ///
-    /// Default value: [`DEFAULT_MAX_ITERATIONS`].
+    /// Default value: 60.
     pub max_iterations: usize,
     /// Ends of the interpolant when the design is given as points.
     ///

@@ -15,13 +15,13 @@ use crate::spline::quintic;
 use crate::spline::{BSplineCurve, MAX_ORDER};
 
 /// Default number of ρ samples `N_s` (spec §5.4 and the test vectors).
-pub const DEFAULT_SAMPLES: usize = 41;
+pub(super) const DEFAULT_SAMPLES: usize = 41;
 
 /// Samples per segment in the automatic `N_s` (spec §5.4: "about 10 per segment").
-pub const SAMPLES_PER_SEGMENT: usize = 10;
+pub(super) const SAMPLES_PER_SEGMENT: usize = 10;
 
 /// Fewest samples accepted: a degree-6 fit needs seven.
-pub const MIN_SAMPLES: usize = MAX_DEGREE + 1;
+pub(crate) const MIN_SAMPLES: usize = MAX_DEGREE + 1;
 
 /// Most samples accepted when given (`samples`, `evaluate --samples`): each iteration
 /// samples ρ and fits the design at every one, about 1 s per 10⁵ for the evaluation and the
@@ -31,16 +31,16 @@ pub const MAX_SAMPLES: usize = 100_000;
 
 /// The default cap `ρ_max`, relative to the arc length of the curve: a sample whose radius
 /// exceeds 100 curve lengths (an arc turning by less than about 0.6°) counts as straight.
-pub const DEFAULT_RHO_MAX_REL: f64 = 100.0;
+pub(super) const DEFAULT_RHO_MAX_REL: f64 = 100.0;
 
 /// The automatic `N_s` for a curve of `segments` spans: `max(41, 10·segments + 1)`.
-pub fn default_samples(segments: usize) -> usize {
+pub(super) fn default_samples(segments: usize) -> usize {
     DEFAULT_SAMPLES.max(SAMPLES_PER_SEGMENT * segments + 1)
 }
 
 /// ρ sampled at equally spaced fractions of the normalised arc length (spec §5.4 steps 1–2).
 #[derive(Clone, Debug, PartialEq)]
-pub struct RhoSamples {
+pub(crate) struct RhoSamples {
     /// The fractions `s_i = i/(N_s − 1)`.
     pub s: Vec<f64>,
     /// The curve parameters `u_i` with arc length `s_i·L`.
@@ -91,7 +91,7 @@ impl RhoSamples {
 /// # Errors
 /// [`Error::InvalidParameter`] for fewer than two samples or a bad `rho_max`,
 /// [`Error::Degenerate`] for a curve of zero or non-finite length.
-pub fn sample_rho(
+pub(super) fn sample_rho(
     curve: &BSplineCurve,
     n_samples: usize,
     rho_max: Option<f64>,

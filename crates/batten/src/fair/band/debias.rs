@@ -104,7 +104,7 @@ pub(super) struct Penalized<'a, const D: usize> {
 impl<'a, const D: usize> Penalized<'a, D> {
     /// `fixed` gives the held unknowns' values, `unit` the energy's scale.
     #[allow(clippy::too_many_arguments)]
-    pub fn new(
+    pub(super) fn new(
         energy: &'a Energy<D>,
         unit: f64,
         design: &'a Design,
@@ -205,7 +205,11 @@ impl<'a, const D: usize> Penalized<'a, D> {
     /// The unconstrained minimiser of `E(s + y) + Σ μ_i |(B y)_i − c_i|²` with the held
     /// unknowns at their values: `(2A + 2 Bᵀ diag μ B) y = 2 Bᵀ μ c − 2 A s` on the free rows
     /// (`weight(i)` gives `μ_i` of point `i`; `uniform` when every point has the same one).
-    pub fn minimiser(&self, weight: impl Fn(usize) -> f64, uniform: bool) -> Result<Vec<f64>> {
+    pub(super) fn minimiser(
+        &self,
+        weight: impl Fn(usize) -> f64,
+        uniform: bool,
+    ) -> Result<Vec<f64>> {
         let held = self.held;
         let dim = self.energy.n * D;
         let mut m = self.base.clone();
@@ -272,7 +276,7 @@ impl<'a, const D: usize> Penalized<'a, D> {
     }
 
     /// The residual `B y − c` of every point (zero at pinned points).
-    pub fn residual(&self, y: &[f64]) -> Vec<f64> {
+    pub(super) fn residual(&self, y: &[f64]) -> Vec<f64> {
         let mut r = vec![0.0; self.points() * D];
         self.design.eval::<D>(y, &mut r);
         for (k, (rk, c)) in r.iter_mut().zip(self.centres).enumerate() {
@@ -296,7 +300,7 @@ impl<'a, const D: usize> Penalized<'a, D> {
     /// `cap` (`E(s)` is the energy of the reference, the passes' result); the smallest `μ`
     /// of the bracket when that one meets the target already. `None` when the reference
     /// already meets the target (nothing to debias) or the smallest `μ` reaches the cap.
-    pub fn discrepancy_weight(
+    pub(super) fn discrepancy_weight(
         &self,
         anchor_energy: f64,
         target: f64,
@@ -359,7 +363,7 @@ impl<'a, const D: usize> Penalized<'a, D> {
     /// feature, and is found. Stops when no window is significant, after [`LOCAL_ROUNDS`], or
     /// before a round whose energy would pass `cap`. Returns the weights and the number of
     /// points whose weight was raised.
-    pub fn local_weights(
+    pub(super) fn local_weights(
         &self,
         mu: f64,
         anchor_energy: f64,

@@ -28,7 +28,7 @@ pub(super) struct SplineMap {
 
 impl Design {
     /// The number of points.
-    pub fn points(&self) -> usize {
+    pub(super) fn points(&self) -> usize {
         match self {
             Design::Points { n } => *n,
             Design::Spline(s) => s.first.len(),
@@ -36,7 +36,7 @@ impl Design {
     }
 
     /// The number of unknown points (control points in the spline form).
-    pub fn vars(&self) -> usize {
+    pub(super) fn vars(&self) -> usize {
         match self {
             Design::Points { n } => *n,
             Design::Spline(s) => s.vars,
@@ -44,7 +44,7 @@ impl Design {
     }
 
     /// `out = B x` (flat, `D` numbers a point).
-    pub fn eval<const D: usize>(&self, x: &[f64], out: &mut [f64]) {
+    pub(super) fn eval<const D: usize>(&self, x: &[f64], out: &mut [f64]) {
         match self {
             Design::Points { .. } => out.copy_from_slice(x),
             Design::Spline(s) => {
@@ -72,7 +72,7 @@ impl Design {
     }
 
     /// `out += Bᵀ r`.
-    pub fn eval_t_add<const D: usize>(&self, r: &[f64], out: &mut [f64]) {
+    pub(super) fn eval_t_add<const D: usize>(&self, r: &[f64], out: &mut [f64]) {
         match self {
             Design::Points { .. } => {
                 for (o, v) in out.iter_mut().zip(r) {
@@ -104,7 +104,7 @@ impl Design {
 
     /// Call `add(row, col, value)` for the entries with `row ≥ col` of `Σ_i B_iᵀ M_i B_i`
     /// (`M_i = blocks[i]`, points with `skip[i]` left out), as the energy reports its own.
-    pub fn for_each_block_lower<const D: usize>(
+    pub(super) fn for_each_block_lower<const D: usize>(
         &self,
         blocks: &[[[f64; D]; D]],
         skip: &[bool],
@@ -176,7 +176,7 @@ impl Design {
     /// Call `add(row, col, value)` for the entries with `row ≥ col` of `Σ_i w_i B_iᵀ B_i`
     /// (`w_i = weight(i)` on every coordinate, points with `skip[i]` left out): the blocks of
     /// [`Design::for_each_block_lower`] when each is `w_i I`, at a quarter of the work in 2-D.
-    pub fn for_each_weight_lower<const D: usize>(
+    pub(super) fn for_each_weight_lower<const D: usize>(
         &self,
         weight: impl Fn(usize) -> f64,
         skip: &[bool],
@@ -234,7 +234,7 @@ impl Design {
     }
 
     /// `out += Σ_i B_iᵀ M_i B_i v` (points with `skip[i]` left out); `work` holds `B v`.
-    pub fn apply_blocks_add<const D: usize>(
+    pub(super) fn apply_blocks_add<const D: usize>(
         &self,
         blocks: &[[[f64; D]; D]],
         skip: &[bool],
@@ -262,7 +262,7 @@ pub(super) mod tests {
 
     /// A small spline map (cyclic when `closed`), with runs of points on each span and
     /// uneven basis values.
-    pub fn map(closed: bool) -> SplineMap {
+    pub(crate) fn map(closed: bool) -> SplineMap {
         let vars = 7;
         let spans = if closed { vars } else { vars - 3 };
         let mut first = Vec::new();

@@ -197,13 +197,13 @@ impl<const D: usize> Energy<D> {
     /// consecutive ones equal (validated input, or a result inside its tolerance band of it,
     /// which the caller checks).
     #[cfg(test)]
-    pub fn build(shape: &[[f64; D]], closed: bool, metric: Metric) -> Energy<D> {
+    pub(super) fn build(shape: &[[f64; D]], closed: bool, metric: Metric) -> Energy<D> {
         Self::build_with_chords(&chords_of(shape, closed), shape, closed, metric)
     }
 
     /// The energy with parameter steps `chords` (`n − 1` of them, `n` when closed; any
     /// positive scale) and the metric's tangents from `shape`.
-    pub fn build_with_chords(
+    pub(super) fn build_with_chords(
         chords: &[f64],
         shape: &[[f64; D]],
         closed: bool,
@@ -239,7 +239,7 @@ impl<const D: usize> Energy<D> {
     /// its first control point, the coefficients of `C'''/6` on its four control points and
     /// its length; the metric's tangent on a span is the chord from its first to its last
     /// control point. The whole is multiplied by `unit`.
-    pub fn spline(
+    pub(super) fn spline(
         ctrl: &[[f64; D]],
         closed: bool,
         spans: &[(usize, [f64; 4], f64)],
@@ -277,7 +277,7 @@ impl<const D: usize> Energy<D> {
     }
 
     /// `E(x)`.
-    pub fn value(&self, x: &[f64]) -> f64 {
+    pub(super) fn value(&self, x: &[f64]) -> f64 {
         self.windows
             .iter()
             .map(|w| {
@@ -294,7 +294,7 @@ impl<const D: usize> Energy<D> {
     }
 
     /// `out += A x`, with `A` the symmetric matrix of `E(x) = xᵀ A x`.
-    pub fn apply_add(&self, x: &[f64], out: &mut [f64]) {
+    pub(super) fn apply_add(&self, x: &[f64], out: &mut [f64]) {
         for w in &self.windows {
             let d = self.delta(w, x);
             let mut md = [0.0; D];
@@ -315,7 +315,7 @@ impl<const D: usize> Energy<D> {
     /// Call `add(row, col, value)` for every entry of `scale · A` with `row ≥ col` in the
     /// (non-cyclic) flat numbering; entries of closed curves that wrap come with the larger
     /// index first as well. Entries at the same position are reported once per window.
-    pub fn for_each_lower(&self, scale: f64, mut add: impl FnMut(usize, usize, f64)) {
+    pub(super) fn for_each_lower(&self, scale: f64, mut add: impl FnMut(usize, usize, f64)) {
         for w in &self.windows {
             for k in 0..4 {
                 let i = (w.first + k) % self.n;

@@ -42,7 +42,7 @@ enum Kind {
 
 impl<const D: usize> Form<D> {
     /// The point form: `held` marks the held points; `chords` the parameter steps.
-    pub fn points(held: &[bool], chords: Vec<f64>, closed: bool) -> Form<D> {
+    pub(super) fn points(held: &[bool], chords: Vec<f64>, closed: bool) -> Form<D> {
         Form {
             design: Design::Points { n: held.len() },
             held: held.to_vec(),
@@ -57,7 +57,7 @@ impl<const D: usize> Form<D> {
     /// of their length, doubled until a feasible start is found. `scaled` is the input in
     /// the solver's units; `hold_ends` holds the end points (position) of an open curve.
     /// `None` when the spans would carry fewer than [`MIN_POINTS_PER_SPAN`] points.
-    pub fn spline(
+    pub(super) fn spline(
         chords: &[f64],
         tolerance: f64,
         scaled: &[f64],
@@ -109,7 +109,7 @@ impl<const D: usize> Form<D> {
     }
 
     /// The energy's scale against the point form's units (see [`Layout::energy_unit`]).
-    pub fn unit(&self) -> f64 {
+    pub(super) fn unit(&self) -> f64 {
         match &self.kind {
             Kind::Points { .. } => 1.0,
             Kind::Spline { unit, .. } => *unit,
@@ -117,13 +117,13 @@ impl<const D: usize> Form<D> {
     }
 
     /// The number of unknowns (points or control points).
-    pub fn vars(&self) -> usize {
+    pub(super) fn vars(&self) -> usize {
         self.design.vars()
     }
 
     /// The first pass's reference, in the solver's units: the points `smoothed` (flat) in
     /// the point form, the feasible start in the spline form.
-    pub fn first_reference(&self, smoothed: Vec<f64>) -> Vec<f64> {
+    pub(super) fn first_reference(&self, smoothed: Vec<f64>) -> Vec<f64> {
         match &self.kind {
             Kind::Points { .. } => smoothed,
             Kind::Spline { fit, .. } => fit.clone(),
@@ -132,7 +132,12 @@ impl<const D: usize> Form<D> {
 
     /// The energy of a pass with `metric`, its tangents from `shape` (the current points, any
     /// units) in the point form, from the control points of `reference` in the spline form.
-    pub fn energy(&self, shape: &[[f64; D]], reference: &[f64], metric: Metric) -> Energy<D> {
+    pub(super) fn energy(
+        &self,
+        shape: &[[f64; D]],
+        reference: &[f64],
+        metric: Metric,
+    ) -> Energy<D> {
         match &self.kind {
             Kind::Points { chords } => {
                 Energy::build_with_chords(chords, shape, self.closed, metric)
@@ -149,7 +154,7 @@ impl<const D: usize> Form<D> {
 
     /// The solver's start relative to `reference`: the point form finds its own; the spline
     /// form starts at its feasible fit.
-    pub fn start(&self, reference: &[f64]) -> Option<Vec<f64>> {
+    pub(super) fn start(&self, reference: &[f64]) -> Option<Vec<f64>> {
         match &self.kind {
             Kind::Points { .. } => None,
             Kind::Spline { fit, .. } => {
@@ -159,7 +164,12 @@ impl<const D: usize> Form<D> {
     }
 
     /// The reference after a solve: the solution's unknowns, absolute.
-    pub fn next_reference(&self, reference: &[f64], scaled: &[f64], sol: &Solution) -> Vec<f64> {
+    pub(super) fn next_reference(
+        &self,
+        reference: &[f64],
+        scaled: &[f64],
+        sol: &Solution,
+    ) -> Vec<f64> {
         match &self.kind {
             Kind::Points { .. } => scaled.iter().zip(&sol.r).map(|(a, r)| a + r).collect(),
             Kind::Spline { .. } => reference.iter().zip(&sol.y).map(|(s, y)| s + y).collect(),
@@ -167,7 +177,7 @@ impl<const D: usize> Form<D> {
     }
 
     /// The held unknowns' values relative to a reference whose ball centres are `centres`.
-    pub fn fixed(&self, centres: &[f64]) -> Vec<f64> {
+    pub(super) fn fixed(&self, centres: &[f64]) -> Vec<f64> {
         match &self.kind {
             Kind::Points { .. } => centres.to_vec(),
             Kind::Spline { .. } => vec![0.0; self.vars() * D],

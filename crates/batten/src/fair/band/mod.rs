@@ -73,12 +73,11 @@ use debias::{ENERGY_CAP, Penalized};
 use energy::{Energy, Metric};
 use form::Form;
 use params::{BandParams, PARAMS};
-pub use params::{DEFAULT_EPS, DEFAULT_MAX_ITERATIONS, DEFAULT_PASSES};
 use solver::{Problem, solve};
 
 /// A point counts as on the band's edge when its displacement is within this fraction of the
 /// tolerance.
-pub const BAND_EDGE_REL: f64 = 1e-4;
+pub(super) const BAND_EDGE_REL: f64 = 1e-4;
 
 /// How many tolerances the averaging window of the first pass's parameters spans.
 const PARAMETER_WINDOW_TOLERANCES: f64 = 4.0;
@@ -106,7 +105,7 @@ pub fn auto_k(n: usize) -> f64 {
     AUTO_TOLERANCE_K.max((2.0 * (n.max(1) as f64).ln()).sqrt())
 }
 
-/// The `band` method.
+/// The `band` method (see `docs/algorithms/band.md`).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Band;
 
@@ -277,7 +276,7 @@ struct Faired<const D: usize> {
 
 /// Above this many points the spline form is tried (`spline.rs`): the point form's solver
 /// stalls from a few thousand points on (see `docs/algorithms/band.md`, Limits).
-pub const DENSE_POINTS: usize = 2000;
+pub(super) const DENSE_POINTS: usize = 2000;
 
 /// Run the passes on points of any dimension and put the result into the band exactly.
 /// `(noise_sigma, noise_dims)`: σ̂ per coordinate and the number of coordinates the noise

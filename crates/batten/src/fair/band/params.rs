@@ -11,17 +11,17 @@ use super::energy::Metric;
 /// Default number of passes (solves), each re-taking the parameters and tangents from the
 /// previous result: the first with the jerk energy, the others with the minimum-variation
 /// energy.
-pub const DEFAULT_PASSES: usize = 3;
+pub(super) const DEFAULT_PASSES: usize = 3;
 /// Default significance of a biased window in the debiasing stage.
 pub(super) const DEFAULT_LOCAL: f64 = 2.0;
 /// Default weight of the speed term of the minimum-variation energy.
 pub(super) const DEFAULT_SPEED: f64 = 0.0;
 /// Default weight of the full jerk inside the minimum-variation energy.
-pub const DEFAULT_EPS: f64 = 0.02;
+pub(super) const DEFAULT_EPS: f64 = 0.02;
 /// Default residual target of the debiasing stage, in noise standard deviations.
-pub const DEFAULT_FIT: f64 = 1.25;
+pub(super) const DEFAULT_FIT: f64 = 1.25;
 /// Default interior-point iterations per pass (`--max-iterations`).
-pub const DEFAULT_MAX_ITERATIONS: usize = 200;
+pub(super) const DEFAULT_MAX_ITERATIONS: usize = 200;
 
 /// The factor of the automatic tolerance (`auto`: [`super::auto_k`]).
 pub(super) const K: Param<Auto<f64>> = Param {
@@ -132,7 +132,7 @@ impl BandParams {
     ///
     /// # Errors
     /// [`crate::Error::InvalidParameter`] naming the parameter and its range.
-    pub fn from_options(options: &FairOptions) -> Result<BandParams> {
+    pub(super) fn from_options(options: &FairOptions) -> Result<BandParams> {
         let k = options.get(&K)?;
         let eps = options.get(&EPS)?;
         let speed = options.get(&SPEED)?;
@@ -155,7 +155,7 @@ impl BandParams {
     }
 
     /// The parameters as used, for the report.
-    pub fn report(&self) -> Map<String, Value> {
+    pub(super) fn report(&self) -> Map<String, Value> {
         let mut parameters = Map::new();
         let p = &mut parameters;
         K.write(p, self.k);

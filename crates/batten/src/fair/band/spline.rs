@@ -60,7 +60,7 @@ impl Layout {
     /// parameter in knot spans (`C'''` scales as `h³`, `dt` as `1/h`). In the point form's
     /// units the objective of dense points is so small (1e-20 at 10⁶ points) that the
     /// solver's stopping rule, absolute below 1e-12 a point, would stop at once.
-    pub fn energy_unit(&self) -> f64 {
+    pub(super) fn energy_unit(&self) -> f64 {
         self.span_length.powi(5)
     }
 }
@@ -69,7 +69,7 @@ impl Layout {
     /// A spline with `spans` uniform knot spans over the parameters `t` (increasing from 0; a
     /// closed curve's period is `period`, and `t < period`). Open curves: clamped, `spans + 3`
     /// control points; closed curves: periodic, `spans` control points.
-    pub fn new(t: &[f64], closed: bool, period: f64, spans: usize) -> Layout {
+    pub(super) fn new(t: &[f64], closed: bool, period: f64, spans: usize) -> Layout {
         if closed {
             Self::periodic(t, period, spans)
         } else {

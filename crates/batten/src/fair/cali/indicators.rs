@@ -16,7 +16,7 @@ use crate::spline::{BSplineCurve, LOCAL_HALF_WIDTH, LOCAL_WIDTH, LambdaOperator,
 /// becomes a curvature error `ε·S/h²` and a κ'' error `ε·S/h⁴`. Below it `LFI_i` is noise — on
 /// collinear data κ is 0 up to rounding, and chasing that noise would slide the points along
 /// the line by a fair part of their spacing.
-pub const ROUNDING_FACTOR: f64 = 16.0;
+pub(super) const ROUNDING_FACTOR: f64 = 16.0;
 
 /// The new control points of a move: the window `P_{i−2..i+2}` with the ends of the polygon
 /// kept.

@@ -113,22 +113,22 @@ use crate::error::{Error, Result};
 use crate::geom::PointSeq;
 use crate::spline::MAX_ORDER;
 
-pub use indicators::{LocalIndicators, ROUNDING_FACTOR, Trial};
+pub use indicators::{LocalIndicators, Trial};
 use run::{Settings, run_cali};
 
 /// The relaxation factor τ of the acceptance test `GFI_new < τ·GFI` (paper §5, spec §4.5).
-pub const DEFAULT_TAU: f64 = 0.99;
+pub(super) const DEFAULT_TAU: f64 = 0.99;
 
 /// Default absolute tolerance in λ of the golden-section search (spec §4.5 \[CHOICE\]).
-pub const DEFAULT_LAMBDA_TOL: f64 = 1e-6;
+pub(super) const DEFAULT_LAMBDA_TOL: f64 = 1e-6;
 
 /// Default spline degree: cubic, as in the paper's tests.
-pub const DEFAULT_DEGREE: usize = 3;
+pub(super) const DEFAULT_DEGREE: usize = 3;
 
 /// Default limit on accepted moves, per input point, when `max_iterations` is not given. The
 /// spec's strophoid reproduction (31 points) accepts 29–55 moves; each accepted move lowers the
 /// GFI by at least the factor τ, so the limit is only a guard against very long runs.
-pub const MAX_MOVES_PER_POINT: usize = 50;
+pub(super) const MAX_MOVES_PER_POINT: usize = 50;
 
 /// The smallest allowed `lambda_tol`: below it the golden section only resolves rounding.
 const MIN_LAMBDA_TOL: f64 = 1e-12;
@@ -168,7 +168,8 @@ const DEGREE: Param<Number<usize>> = Param {
 
 static PARAMS: &[ParamSpec] = &[TAU.spec(), LAMBDA_TOL.spec(), DEGREE.spec()];
 
-/// The `cali` fairing method (see the module documentation).
+/// The `cali` fairing method (see `docs/algorithms/cali.md`, and the module docs of
+/// `fair/cali/mod.rs` in the source).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Cali;
 

@@ -7,12 +7,12 @@ use crate::geom::Vec2;
 
 /// Relative margin kept inside the tolerance when a move is scaled back onto it, so that
 /// rounding cannot put a point beyond the tolerance.
-pub const TOLERANCE_MARGIN: f64 = 1e-9;
+pub(super) const TOLERANCE_MARGIN: f64 = 1e-9;
 
 /// A move that would leave a chord to a neighbour shorter than this fraction of the data's
 /// size (its bounding-box diagonal) is refused: coincident consecutive points have no
 /// chord-length parameter.
-pub const MIN_CHORD_REL: f64 = 1e-9;
+pub(crate) const MIN_CHORD_REL: f64 = 1e-9;
 
 /// The radius a point may reach from its original position under the tolerance `tol`: `tol`
 /// less the relative margin [`TOLERANCE_MARGIN`], so that rounding cannot put it beyond `tol`.

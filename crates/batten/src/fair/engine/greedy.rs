@@ -12,25 +12,25 @@ use crate::fair::{FairOptions, FairStatus, HistoryRow, Move, ParamSpec};
 
 /// Default relative stopping threshold: the run stops when every `|J_k|` is at most this
 /// fraction of the largest jump of the input.
-pub const DEFAULT_THRESHOLD: f64 = 1e-3;
+pub(super) const DEFAULT_THRESHOLD: f64 = 1e-3;
 
 /// Default iteration limit, per candidate point (bad points for `kjellander`, `poliakoff`
 /// and `energy`; interior knots for `sapidis-farin`): one iteration is one move.
-pub const DEFAULT_MOVES_PER_POINT: usize = 10;
+pub(super) const DEFAULT_MOVES_PER_POINT: usize = 10;
 
 /// A move that the tolerance cuts to less than this fraction of its full length cannot help;
 /// the point is skipped and the next-worst point tried.
-pub const MIN_STEP_FRACTION: f64 = 1e-2;
+pub(super) const MIN_STEP_FRACTION: f64 = 1e-2;
 
 /// A point skipped because the tolerance blocks its move is tried again once its jump has
 /// changed by more than this fraction (a move nearby changed its neighbourhood); smaller
 /// changes, such as the far tail of a windowed re-solve, leave it skipped.
-pub const RETRY_CHANGE_REL: f64 = 1e-6;
+pub(super) const RETRY_CHANGE_REL: f64 = 1e-6;
 
 /// A jump no larger than this fraction of the terms it is computed from is rounding noise
 /// and counts as zero (so exactly fair data, e.g. equally spaced collinear points, is left
 /// alone instead of being "faired" at the level of rounding errors).
-pub const JUMP_ZERO_REL: f64 = 1e-12;
+pub(crate) const JUMP_ZERO_REL: f64 = 1e-12;
 
 /// The stopping threshold ε: relative to the input's largest badness, or absolute.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -11,11 +11,9 @@
 mod budget;
 mod greedy;
 
-pub use budget::{MIN_CHORD_REL, TOLERANCE_MARGIN};
+pub(super) use budget::MIN_CHORD_REL;
 pub(crate) use budget::{max_fraction, step_fraction, tolerance_radius};
-pub use greedy::{
-    DEFAULT_MOVES_PER_POINT, DEFAULT_THRESHOLD, JUMP_ZERO_REL, MIN_STEP_FRACTION, RETRY_CHANGE_REL,
-};
+pub(super) use greedy::JUMP_ZERO_REL;
 pub(crate) use greedy::{
     EPSILON, JUMP_PARAMS, LocalProblem, MaxTree, THRESHOLD, Threshold, drive, driven_parameters,
     move_limit,

@@ -124,28 +124,20 @@ mod pipeline;
 mod responses;
 mod segment;
 mod sign;
+#[cfg(test)]
+mod tests;
 
 use super::{EndFix, FairMethod, FairStatus, Outcome, ParamSpec, clamp_to_tolerance};
 use crate::error::Result;
 use crate::fair::FairOptions;
 use crate::geom::PointSeq;
 
-pub use params::{
-    DEFAULT_ALPHA_FACTOR, DEFAULT_FINE_RUN3, DEFAULT_ITERATIONS, DEFAULT_LAMBDA_COARSE,
-    DEFAULT_LAMBDA_FINE, DEFAULT_MAX_TURN, DEFAULT_OVERLAP, DEFAULT_PASSES, MAX_OVERLAP,
-    PAPER_MAX_TURN, RECOMMENDED_MAX_TURN,
-};
 use params::{HanParams, PARAMS};
-pub use partition::{Span, chord_angles, partition, turning_angles};
-pub use pipeline::{MAX_LOCAL_SLOPE, MAX_RECORDED_MOVES, MIN_FALLBACK_TURN};
 use pipeline::{Passes, RunLog, run_passes};
-pub use responses::{Changed, RESPONSE_CUTOFF_REL, UnitResponses};
-pub use segment::{
-    CaseMove, MIN_SEGMENT_POINTS, MoveTag, Procedure, ROUNDING_FLOOR_FACTOR, SINGULAR_REL, Segment,
-    SegmentParams,
-};
+pub use segment::{CaseMove, MoveTag, Segment, SegmentParams};
 
-/// The `han` method: see the module documentation.
+/// The `han` method: see `docs/algorithms/han.md`, and the module docs of `fair/han/mod.rs` in
+/// the source.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Han;
 

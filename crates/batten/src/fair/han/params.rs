@@ -1,7 +1,7 @@
 //! `han`'s parameters: their defaults, the table `batten methods` shows, and the typed values
 //! of a run parsed from the options (`docs/algorithms/han.md`, "Parameters").
 
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::FRAC_PI_2;
 
 use serde_json::{Map, Value};
 
@@ -11,35 +11,31 @@ use crate::fair::params::{Angle, Flag, Number, Param};
 use crate::fair::{FairOptions, ParamSpec};
 
 /// Default damping of coarse case 1, `λ_c` \[PAPER\].
-pub const DEFAULT_LAMBDA_COARSE: f64 = 0.8;
+pub(super) const DEFAULT_LAMBDA_COARSE: f64 = 0.8;
 /// Default weight of the outer points in the fine cases, `λ_f` \[PAPER\].
-pub const DEFAULT_LAMBDA_FINE: f64 = 0.75;
+pub(super) const DEFAULT_LAMBDA_FINE: f64 = 0.75;
 /// Default factor of the fine-phase α rule, `α = factor · v` \[PAPER: 1/5\].
-pub const DEFAULT_ALPHA_FACTOR: f64 = 0.2;
+pub(super) const DEFAULT_ALPHA_FACTOR: f64 = 0.2;
 /// Whether the `han` method runs fine case 3 ([`SegmentParams::fine_run3`]), an extension
 /// not in the paper \[CHOICE\]: on the peer comparison it is what makes `han` leave no more
 /// spurious inflections than csaps in every case (`fine_run3=false` gives the paper's method).
-pub const DEFAULT_FINE_RUN3: bool = true;
+pub(super) const DEFAULT_FINE_RUN3: bool = true;
 /// Default number of points shared by consecutive segments, k \[PAPER\].
-pub const DEFAULT_OVERLAP: usize = 5;
+pub(super) const DEFAULT_OVERLAP: usize = 5;
 
 /// Largest `overlap` accepted: an overlap beyond a segment's length changes nothing, and this
 /// is more points than any segment holds in practice.
-pub const MAX_OVERLAP: usize = 1_000_000;
+pub(super) const MAX_OVERLAP: usize = 1_000_000;
 /// Default number of pipeline passes (partition, fair, blend) \[CHOICE\].
-pub const DEFAULT_PASSES: usize = 3;
-/// The paper's turning threshold of the partition, π \[PAPER\] (`--set max_turn=pi`).
-pub const PAPER_MAX_TURN: f64 = PI;
+pub(super) const DEFAULT_PASSES: usize = 3;
 /// Default turning threshold of the partition, π/2 \[CHOICE\]: the value the spec recommends
 /// (§1.8 note). Segments then stay far from vertical local slopes, where the function-spline
 /// proxy breaks down; with the paper's π the end chords of a densely sampled segment are
 /// nearly vertical in its frame. Measured on the peer comparison (`bench/compare_peers.py`),
 /// π/2 (with fine case 3) is what makes `han` leave no more spurious inflections than csaps.
-pub const DEFAULT_MAX_TURN: f64 = FRAC_PI_2;
-/// The recommended turning threshold: the default, π/2.
-pub const RECOMMENDED_MAX_TURN: f64 = DEFAULT_MAX_TURN;
+pub(super) const DEFAULT_MAX_TURN: f64 = FRAC_PI_2;
 /// Default iterations per segment, T \[CHOICE §1.7.3\].
-pub const DEFAULT_ITERATIONS: usize = 10;
+pub(super) const DEFAULT_ITERATIONS: usize = 10;
 
 /// `λ_c` ([`DEFAULT_LAMBDA_COARSE`]).
 pub(super) const LAMBDA_COARSE: Param<Number<f64>> = Param {

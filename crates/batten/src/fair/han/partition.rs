@@ -10,7 +10,7 @@ use crate::geom::{Point, Vec2};
 /// A function segment of a point sequence: points `start..=end` (0-based, inclusive) and the
 /// direction θ (radians) of its local x axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Span {
+pub(super) struct Span {
     /// First point.
     pub start: usize,
     /// Last point (inclusive).
@@ -19,23 +19,11 @@ pub struct Span {
     pub theta: f64,
 }
 
-impl Span {
-    /// Number of points.
-    pub fn len(&self) -> usize {
-        self.end + 1 - self.start
-    }
-
-    /// Always false: a span has at least two points.
-    pub fn is_empty(&self) -> bool {
-        self.end < self.start
-    }
-}
-
 /// Chord directions `φ_i = atan2(P_{i+1} − P_i)`, i = 0..N−2.
 ///
 /// # Errors
 /// [`Error::NonFinite`], [`Error::DuplicatePoint`] (zero chord).
-pub fn chord_angles(points: &[Point]) -> Result<Vec<f64>> {
+pub(super) fn chord_angles(points: &[Point]) -> Result<Vec<f64>> {
     if let Some(index) = points.iter().position(|p| !p.is_finite()) {
         return Err(Error::NonFinite { index });
     }
@@ -59,7 +47,8 @@ pub fn chord_angles(points: &[Point]) -> Result<Vec<f64>> {
 ///
 /// # Errors
 /// As [`chord_angles`].
-pub fn turning_angles(points: &[Point]) -> Result<Vec<f64>> {
+#[cfg(test)]
+pub(super) fn turning_angles(points: &[Point]) -> Result<Vec<f64>> {
     let phi = chord_angles(points)?;
     Ok(unwrap_turning(&phi))
 }
@@ -95,7 +84,7 @@ fn wrap_angle(a: f64) -> f64 {
 /// # Errors
 /// [`Error::TooFewPoints`] for fewer than 2 points, [`Error::InvalidParameter`] for a
 /// `max_turn` outside (0, π] or `overlap` = 0, and the errors of [`chord_angles`].
-pub fn partition(points: &[Point], max_turn: f64, overlap: usize) -> Result<Vec<Span>> {
+pub(super) fn partition(points: &[Point], max_turn: f64, overlap: usize) -> Result<Vec<Span>> {
     if points.len() < 2 {
         return Err(Error::TooFewPoints {
             needed: 2,

@@ -17,7 +17,7 @@ use crate::geom::{Point, PointSeq, Vec2, max_abs_coordinate};
 
 /// A segment that is too steep in its frame is re-partitioned with half the turning
 /// threshold, down to this one; below it the segment is left unfaired (\[CHOICE\]).
-pub const MIN_FALLBACK_TURN: f64 = PI / 8.0;
+pub(super) const MIN_FALLBACK_TURN: f64 = PI / 8.0;
 /// A segment with a chord steeper than this in its bisector frame (`|ΔY/ΔX|`, ≈ 89.4°) is
 /// re-partitioned with half the turning threshold, down to π/8, and left unfaired only past
 /// that (\[CHOICE\] guard). The function-spline proxy assumes moderate slopes (spec §1.8
@@ -26,9 +26,9 @@ pub const MIN_FALLBACK_TURN: f64 = PI / 8.0;
 /// turns by almost π; their spacing ratios reach 1e-6, the unit responses are huge and the
 /// moves diverge (we saw a point thrown 500 curve sizes away). With `max_turn = π/2` segments
 /// have slopes ≤ 1 unless extended.
-pub const MAX_LOCAL_SLOPE: f64 = 100.0;
+pub(super) const MAX_LOCAL_SLOPE: f64 = 100.0;
 /// At most this many moves are listed in the report; later moves are counted, not listed.
-pub const MAX_RECORDED_MOVES: usize = 10_000;
+pub(super) const MAX_RECORDED_MOVES: usize = 10_000;
 /// The tolerance is shrunk by this relative amount before use, so that rounding in the frame
 /// changes cannot push a point over the bound.
 const TOLERANCE_SAFETY_REL: f64 = 1e-9;

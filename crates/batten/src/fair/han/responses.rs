@@ -9,7 +9,7 @@ use crate::spline::{CubicSplineFn, FnEndCondition};
 /// The summed response column of a move is walked outward until its entries fall to this
 /// fraction of its largest entry. Below half an ulp of the largest change, so the truncated
 /// update equals eq 13 to rounding.
-pub const RESPONSE_CUTOFF_REL: f64 = 1e-17;
+pub(super) const RESPONSE_CUTOFF_REL: f64 = 1e-17;
 
 /// HAN's unit spline responses `c̃_i^j` (spec §1.6, eqs 14–17 with the end fix) and the
 /// derived `ẽ_i^j`, for the end condition `c_1 = c_2`, `c_{n−1} = c_n`. They depend on x only.
@@ -19,7 +19,7 @@ pub const RESPONSE_CUTOFF_REL: f64 = 1e-17;
 /// `c̃_i^j = −a*_i c̃_{i−1}^j` (i ≥ j+2), O(|i−j|) each. Indices are 0-based; the columns are
 /// the interior points `1..=n−2`.
 #[derive(Clone, Debug, PartialEq)]
-pub struct UnitResponses {
+pub(crate) struct UnitResponses {
     h: Vec<f64>,
     pub(super) inv_h: Vec<f64>,
     /// Forward sweep `a`, length n − 1 (`a[0] = −1`).
@@ -39,7 +39,8 @@ impl UnitResponses {
     ///
     /// # Errors
     /// As [`CubicSplineFn::try_new`].
-    pub fn new(x: &[f64]) -> Result<UnitResponses> {
+    #[cfg(test)]
+    pub(crate) fn new(x: &[f64]) -> Result<UnitResponses> {
         let s = CubicSplineFn::try_new(x.to_vec(), vec![0.0; x.len()], FnEndCondition::Han)?;
         UnitResponses::from_spline(&s)
     }
@@ -49,7 +50,7 @@ impl UnitResponses {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] for another end condition.
-    pub fn from_spline(spline: &CubicSplineFn) -> Result<UnitResponses> {
+    pub(crate) fn from_spline(spline: &CubicSplineFn) -> Result<UnitResponses> {
         if spline.end_condition() != FnEndCondition::Han {
             return Err(Error::InvalidParameter {
                 name: "end condition".into(),
@@ -105,13 +106,8 @@ impl UnitResponses {
     }
 
     /// Number of points n.
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.diag.len()
-    }
-
-    /// Always false (n ≥ 3).
-    pub fn is_empty(&self) -> bool {
-        self.diag.is_empty()
     }
 
     /// `c̃_i^j`: the change of `c_i` per unit move of `y_j`, for `i < n` and an interior j.
@@ -119,7 +115,8 @@ impl UnitResponses {
     ///
     /// # Panics
     /// When j is not interior or i is out of range.
-    pub fn c(&self, i: usize, j: usize) -> f64 {
+    #[cfg(test)]
+    pub(crate) fn c(&self, i: usize, j: usize) -> f64 {
         let n = self.len();
         assert!(
             j >= 1 && j + 1 < n && i < n,
@@ -159,7 +156,8 @@ impl UnitResponses {
     ///
     /// # Panics
     /// As [`UnitResponses::c`].
-    pub fn e(&self, i: usize, j: usize) -> f64 {
+    #[cfg(test)]
+    pub(crate) fn e(&self, i: usize, j: usize) -> f64 {
         let n = self.len();
         assert!(
             j >= 1 && j + 1 < n && i < n,
@@ -191,7 +189,8 @@ impl UnitResponses {
     ///
     /// # Panics
     /// As [`UnitResponses::c`].
-    pub fn column_c(&self, j: usize) -> Vec<f64> {
+    #[cfg(test)]
+    pub(crate) fn column_c(&self, j: usize) -> Vec<f64> {
         let n = self.len();
         let mut col = vec![0.0; n];
         col[j] = self.c(j, j);
@@ -210,7 +209,8 @@ impl UnitResponses {
     ///
     /// # Panics
     /// As [`UnitResponses::c`].
-    pub fn column_e(&self, j: usize) -> Vec<f64> {
+    #[cfg(test)]
+    pub(crate) fn column_e(&self, j: usize) -> Vec<f64> {
         let c = self.column_c(j);
         let n = c.len();
         let mut e = vec![0.0; n];
@@ -227,7 +227,7 @@ impl UnitResponses {
     ///
     /// # Panics
     /// When the moved points are not all interior or `c` has the wrong length.
-    pub fn add_columns(&self, start: usize, gammas: &[f64], c: &mut [f64]) -> Changed {
+    pub(crate) fn add_columns(&self, start: usize, gammas: &[f64], c: &mut [f64]) -> Changed {
         let n = self.len();
         assert_eq!(c.len(), n, "add_columns: c has the wrong length");
         assert!(
@@ -293,7 +293,7 @@ impl UnitResponses {
 /// The entries of an array that a local update rewrote: `lo..=hi`, and the largest new
 /// magnitude among them.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Changed {
+pub(crate) struct Changed {
     /// First rewritten index.
     pub lo: usize,
     /// Last rewritten index (inclusive).

@@ -14,10 +14,8 @@ use crate::error::{Error, Result};
 use crate::geom::Point;
 use crate::spline::{CubicSplineFn, FnEndCondition};
 
-pub use cases::SINGULAR_REL;
-
 /// The fewest points a function segment must have to be faired (spec §1.7).
-pub const MIN_SEGMENT_POINTS: usize = 5;
+pub(super) const MIN_SEGMENT_POINTS: usize = 5;
 /// Rounding-noise floor of the sign tests \[CHOICE\]. Rounding the coordinates (magnitude R) to
 /// double precision puts noise of up to about `0.4·ε·R/h²` into c and `4·0.4·ε·R/h³` into e
 /// (measured on 10⁶ samples of a sine, offset by 100, with spacing h): on dense data every e,
@@ -27,7 +25,7 @@ pub const MIN_SEGMENT_POINTS: usize = 5;
 /// — the factor of the curve metrics' floor. It changes nothing on data whose noise is above
 /// rounding; on a clean curve it keeps `han` from fairing rounding noise (a clean 10⁶-point
 /// spiral made 5.4 million moves without it, none with it).
-pub const ROUNDING_FLOOR_FACTOR: f64 = 64.0;
+pub(super) const ROUNDING_FLOOR_FACTOR: f64 = 64.0;
 
 /// The parameters of the fairing of one function segment.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,15 +33,15 @@ pub const ROUNDING_FLOOR_FACTOR: f64 = 64.0;
 pub struct SegmentParams {
     /// Damping `λ_c` of coarse case 1.
     ///
-    /// Default value: [`DEFAULT_LAMBDA_COARSE`] (0.8).
+    /// Default value: 0.8.
     pub lambda_coarse: f64,
     /// Weight `λ_f` of the outer points in the fine cases.
     ///
-    /// Default value: [`DEFAULT_LAMBDA_FINE`] (0.75).
+    /// Default value: 0.75.
     pub lambda_fine: f64,
     /// Factor of the α rule of the fine cases.
     ///
-    /// Default value: [`DEFAULT_ALPHA_FACTOR`] (0.2).
+    /// Default value: 0.2.
     pub alpha_factor: f64,
     /// Also run fine case 3 ([`Segment::fine_case3`]) after fine case 2 in every iteration:
     /// an extension, not in the paper, for runs of three points of one sign of c, which
@@ -204,7 +202,7 @@ impl CaseMove {
 
 /// The five case procedures of one iteration, in the spec's order (§1.7.3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Procedure {
+pub(crate) enum Procedure {
     /// Coarse case 1 ([`Segment::coarse_case1`]).
     CoarseCase1,
     /// Coarse case 2 with its end rules ([`Segment::coarse_case2`]).
@@ -222,7 +220,7 @@ pub enum Procedure {
 
 impl Procedure {
     /// One iteration: phase 1 (cases 1, 2, 3), then phase 2 (cases 1, 2).
-    pub const ITERATION: [Procedure; 5] = [
+    pub(crate) const ITERATION: [Procedure; 5] = [
         Procedure::CoarseCase1,
         Procedure::CoarseCase2,
         Procedure::CoarseCase3,
@@ -234,18 +232,18 @@ impl Procedure {
 /// A function segment `(x_i, y_i)`, i = 1..n, being faired by HAN's two phases (spec §1.7).
 ///
 /// It holds y, the spline coefficients c, the indicator e and the unit responses, and keeps
-/// c and e exact after every move (eq 13, see the module docs). Only `y_2..y_{n−1}` move; the
+/// c and e exact after every move (eq 13, see `docs/algorithms/han.md`). Only `y_2..y_{n−1}` move; the
 /// x values and the end values never change. Indices are 0-based (point k is the paper's
 /// k + 1).
 ///
 /// ```
-/// use batten::fair::han::Segment;
+/// use batten::fair::HanSegment;
 ///
 /// let x: Vec<f64> = (0..30).map(|i| i as f64 * 0.4).collect();
 /// let y: Vec<f64> = x.iter().enumerate()
 ///     .map(|(i, v)| (v / 2.0).sin() + if i % 2 == 0 { 0.02 } else { -0.02 })
 ///     .collect();
-/// let mut seg = Segment::new(x, y).unwrap();
+/// let mut seg = HanSegment::new(x, y).unwrap();
 /// let before = seg.inflection_count();
 /// seg.fair(10, |_| {});
 /// assert!(seg.inflection_count() < before);
@@ -276,7 +274,7 @@ impl Segment {
     /// A segment through `(x[k], y[k])` with the default parameters and no bounds.
     ///
     /// # Errors
-    /// [`Error::TooFewPoints`] below [`MIN_SEGMENT_POINTS`], and the errors of
+    /// [`Error::TooFewPoints`] below 5 points, and the errors of
     /// [`CubicSplineFn::try_new`] (length mismatch, NaN, x not strictly increasing).
     pub fn new(x: Vec<f64>, y: Vec<f64>) -> Result<Segment> {
         if x.len() < MIN_SEGMENT_POINTS {
@@ -333,7 +331,7 @@ impl Segment {
     /// Declare that the points carry the rounding of coordinates of magnitude up to
     /// `magnitude` (e.g. those of the whole curve, before the segment was moved into its
     /// frame), not only of their own: the rounding-noise floors of the sign tests
-    /// ([`ROUNDING_FLOOR_FACTOR`]) are raised accordingly. A non-finite or negative value is
+    /// ([`Segment::c_floor`], [`Segment::e_floor`]) are raised accordingly. A non-finite or negative value is
     /// ignored.
     pub fn with_coordinate_scale(mut self, magnitude: f64) -> Segment {
         if magnitude.is_finite() && magnitude > 0.0 {
@@ -440,17 +438,14 @@ impl Segment {
         &self.e
     }
 
-    /// The unit responses of the segment's abscissae.
-    pub fn responses(&self) -> &UnitResponses {
-        &self.resp
-    }
-
-    /// The rounding-noise floor of each `c_i` ([`ROUNDING_FLOOR_FACTOR`]).
+    /// The rounding-noise floor of each `c_i`: values of c at most `64·ε·R/h²` (R the
+    /// coordinate magnitude, h the shorter chord at the point) count as 0 in the sign tests.
     pub fn c_floor(&self) -> &[f64] {
         &self.c_floor
     }
 
-    /// The rounding-noise floor of each `e_i` ([`ROUNDING_FLOOR_FACTOR`]).
+    /// The rounding-noise floor of each `e_i`: values of e at most `4·64·ε·R/h³` count as 0
+    /// in the sign tests.
     pub fn e_floor(&self) -> &[f64] {
         &self.e_floor
     }
@@ -475,7 +470,8 @@ impl Segment {
         count_strict_changes(&self.e, &self.e_floor, abs_max(&self.e))
     }
 
-    /// Run `iterations` iterations of [`Procedure::ITERATION`], calling `on_move` for every
+    /// Run `iterations` iterations of the case procedures (coarse cases 1–3, fine cases 1 and
+    /// 2, and fine case 3 when [`SegmentParams::fine_run3`] is set), calling `on_move` for every
     /// move. Stops early when an iteration makes no move (the state is then a fixed point).
     /// Returns the number of iterations that made at least one move.
     pub fn fair(&mut self, iterations: usize, mut on_move: impl FnMut(&CaseMove)) -> usize {
@@ -503,7 +499,7 @@ impl Segment {
     }
 
     /// Run one case procedure over the segment, calling `on_move` for every move.
-    pub fn run_procedure(&mut self, p: Procedure, on_move: &mut impl FnMut(&CaseMove)) {
+    pub(crate) fn run_procedure(&mut self, p: Procedure, on_move: &mut impl FnMut(&CaseMove)) {
         match p {
             Procedure::CoarseCase1 => self.coarse_case1_with(on_move),
             Procedure::CoarseCase2 => self.coarse_case2_with(on_move),

@@ -115,32 +115,25 @@ use crate::error::Result;
 use crate::geom::PointSeq;
 
 use super::engine::{EPSILON, JUMP_PARAMS};
-// The engine's constants, at the paths they had when the engine lived here.
-pub use super::engine::{
-    DEFAULT_MOVES_PER_POINT, DEFAULT_THRESHOLD, JUMP_ZERO_REL, MIN_CHORD_REL, MIN_STEP_FRACTION,
-    RETRY_CHANGE_REL, TOLERANCE_MARGIN,
-};
-pub use hermite::{HERMITE_PARAMS, fair_hermite};
+pub use hermite::fair_hermite;
 use params::{ENERGY_PARAMS, POLIAKOFF_PARAMS, energy_rule, point_params};
-pub use points::SOLVE_HALF_WIDTH;
 use points::run_points;
-pub use rules::{
-    HermiteMove, KpRule, UNIT_STEP_REL, energy_change_f, hermite_step, parametric_energy,
-};
+pub use rules::{HermiteMove, KpRule, energy_change_f, hermite_step, parametric_energy};
 
-/// Method `kjellander`: uniform parametric cubic, the bad point moved by eq 4 (see the module
-/// docs).
+/// Method `kjellander`: uniform parametric cubic, the bad point moved by eq 4 (see
+/// `docs/algorithms/kjellander-poliakoff.md`, and the module docs of `fair/kjellander/mod.rs`
+/// in the source).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Kjellander;
 
-/// Method `poliakoff`: chord-length parametric cubic, the bad point moved by eq 8 (see the
-/// module docs).
+/// Method `poliakoff`: chord-length parametric cubic, the bad point moved by eq 8 (see
+/// `docs/algorithms/kjellander-poliakoff.md`).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Poliakoff;
 
 /// Method `energy`: chord-length parametric cubic, the bad point moved by the energy-optimal
 /// `δ*` of eqs 11–12 (spec §2.5), or by the position-only optimum with `mode = position`
-/// (see the module docs).
+/// (see `docs/algorithms/kjellander-poliakoff.md`).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Energy;
 

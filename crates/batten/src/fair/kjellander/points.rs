@@ -18,7 +18,7 @@ use crate::numeric::{solve_cyclic_tridiagonal, solve_tridiagonal};
 /// Half-width of the window of tangents re-solved after a move (see the module docs,
 /// "Cost"): the influence of a move decays at least by 1/2 per index, so 64 indices leave
 /// a truncation error below 2⁻⁶⁴ ≈ 5e-20 of the tangent change at the moved point.
-pub const SOLVE_HALF_WIDTH: usize = 64;
+pub(super) const SOLVE_HALF_WIDTH: usize = 64;
 
 /// The C² interpolating cubic (natural or periodic) of the current points, with its
 /// tangents, spans and the original points.

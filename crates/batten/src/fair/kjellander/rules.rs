@@ -12,7 +12,7 @@ use crate::spline::ParametricCubic;
 
 /// Kjellander's rule (eq 4) needs unit parameter steps; steps within this relative distance
 /// of 1 count as unit steps.
-pub const UNIT_STEP_REL: f64 = 1e-9;
+pub(super) const UNIT_STEP_REL: f64 = 1e-9;
 
 /// The update rule for the bad point (spec §2.2–2.5).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -31,6 +31,7 @@ pub enum KpRule {
 
 /// One move of the bad point `k` of Hermite data (see [`hermite_step`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct HermiteMove {
     /// The new position `r_k + δ`.
     pub point: Point,

@@ -61,18 +61,11 @@ use super::{FairMethod, FairOptions, Outcome, ParamSpec};
 use crate::error::Result;
 use crate::geom::PointSeq;
 
-pub use crate::analysis::roc_fairness::{
-    DEFAULT_MAX_ITERATIONS, DEFAULT_METHOD_GRADIENT_FRACTION, DEFAULT_RHO_MAX_REL, DEFAULT_SAMPLES,
-    DIAG_FLOOR_REL, DegreeResult, Design, DesignEnds, Evaluation, KuraganoOptions, MAX_DEGREE,
-    MAX_SAMPLES, MIN_DEGREE, MIN_SAMPLES, MU_FACTOR, MU_INITIAL, MU_MAX, Modification,
-    ModificationStep, PAPER_TIE_TOLERANCE, Residual, RhoFit, RhoSamples, SAMPLES_PER_SEGMENT,
-    ShapeConstraints, StopReason, TIE_TOLERANCE, angle_degrees, cosine, default_samples, evaluate,
-    modify_shape, rho_gradient, sample_rho, select_best, select_best_within, truncate_angle,
-};
 use params::{LENGTH_PARAMS, PARAMS};
 use run::run_points;
 
-/// The `kuragano` fairing method (see the module docs).
+/// The `kuragano` fairing method (see `docs/algorithms/kuragano.md`, and the module docs of
+/// `fair/kuragano/mod.rs` in the source).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Kuragano;
 

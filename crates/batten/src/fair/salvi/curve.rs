@@ -22,14 +22,14 @@ use crate::spline::{BSplineCurve, MAX_ORDER};
 /// A search that lowers the local measure of the moved point by less than this fraction
 /// counts as no progress: the point is skipped until a neighbour makes progress
 /// (`skip_stalled`).
-pub const STALL_REL_IMPROVEMENT: f64 = 1e-3;
+pub(super) const STALL_REL_IMPROVEMENT: f64 = 1e-3;
 
 /// The simplex edge s is this fraction of the mean length of the control-polygon legs at the
 /// moved point (spec §3 step 6).
-pub const SIMPLEX_STEP_REL: f64 = 0.1;
+pub(super) const SIMPLEX_STEP_REL: f64 = 0.1;
 
 /// Simplex evaluation budget per move (spec §3 step 6).
-pub const SIMPLEX_MAX_EVALUATIONS: usize = 400;
+pub(super) const SIMPLEX_MAX_EVALUATIONS: usize = 400;
 
 /// What [`fair_curve`] did, with the sampled curvatures.
 #[derive(Clone, Debug, PartialEq)]
@@ -127,13 +127,15 @@ impl Samples {
     }
 }
 
-/// Fair `curve` by Salvi & Várady's method (see the module documentation). Knots, degree
+/// Fair `curve` by Salvi & Várady's method (see `docs/algorithms/salvi-varady.md`). Knots, degree
 /// and weights are kept; the result is within δ of `curve` at every parameter.
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] for a degree below 2, fewer than [`MIN_SAMPLES`] samples, a
-/// non-positive tolerance; [`Error::Degenerate`] when the curvature is undefined at a sample;
-/// the errors of [`target_curvature`].
+/// [`Error::InvalidParameter`] for a degree below 2, fewer than 4 samples, a non-positive
+/// tolerance; [`Error::Degenerate`] when the curvature is undefined at a sample; the errors of
+/// the target curvature ([`Error::LengthMismatch`] for a given target of the wrong length,
+/// [`Error::InvalidParameter`] for a B-spline fit with fewer than 4 coefficients,
+/// [`Error::Degenerate`] for a curve of zero length or zero speed, [`Error::Singular`]).
 pub fn fair_curve(
     curve: &BSplineCurve,
     params: &SalviParams,

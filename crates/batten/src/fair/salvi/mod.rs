@@ -92,6 +92,8 @@
 mod curve;
 mod params;
 mod target;
+#[cfg(test)]
+mod tests;
 
 use super::local::{self, json_f64};
 use super::{FairMethod, FairOptions, Outcome, ParamSpec};
@@ -99,16 +101,10 @@ use crate::error::Result;
 use crate::geom::PointSeq;
 use crate::spline::BSplineCurve;
 
-pub use curve::{
-    SIMPLEX_MAX_EVALUATIONS, SIMPLEX_STEP_REL, STALL_REL_IMPROVEMENT, SalviReport, fair_curve,
-};
-pub use params::{DEFAULT_MAX_ITERATIONS, DEFAULT_WINDOW, SalviParams, WINDOW_MIN_REL_IMPROVEMENT};
+pub use curve::{SalviReport, fair_curve};
+pub use params::SalviParams;
 use params::{PARAMS, report_params, salvi_params};
-pub use target::{
-    DEFAULT_PASSES, DEFAULT_SAMPLES, HALF_WIDTH_DIVISOR, LOOSE_SAMPLES_PER_COEFFICIENT,
-    MAX_SAMPLES, MIN_SAMPLES, MIN_TARGET_COEFFICIENTS, SAMPLES_PER_SPAN, Smoother, moving_average,
-    sample_count, sample_curvature, target_curvature, target_measure,
-};
+pub use target::{MAX_SAMPLES, Smoother};
 
 /// The `salvi` method for point input: fit a B-spline, fair it, evaluate it at the fitted
 /// parameters.

@@ -10,13 +10,13 @@ use crate::fair::params::{Auto, Choice, Flag, Number, Param};
 use crate::fair::{FairOptions, ParamSpec};
 
 /// Default iteration limit (the paper's Table 1 runs 1000 iterations).
-pub const DEFAULT_MAX_ITERATIONS: usize = 1000;
+pub(super) const DEFAULT_MAX_ITERATIONS: usize = 1000;
 
 /// Default window M of the stopping rule.
-pub const DEFAULT_WINDOW: usize = 50;
+pub(super) const DEFAULT_WINDOW: usize = 50;
 
 /// Stop when Ê fell by less than this fraction of its value M iterations earlier.
-pub const WINDOW_MIN_REL_IMPROVEMENT: f64 = 1e-3;
+pub(super) const WINDOW_MIN_REL_IMPROVEMENT: f64 = 1e-3;
 
 /// Parameters of [`fair_curve`]. Start from [`SalviParams::DEFAULT`].
 ///

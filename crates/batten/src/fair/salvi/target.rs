@@ -11,13 +11,13 @@ use crate::numeric::SymBanded;
 use crate::spline::{BSplineCurve, KnotVector, MAX_ORDER};
 
 /// Spec default number of samples N (§3 step 2).
-pub const DEFAULT_SAMPLES: usize = 200;
+pub(super) const DEFAULT_SAMPLES: usize = 200;
 
 /// The default sample count is at least this many per non-empty knot span.
-pub const SAMPLES_PER_SPAN: usize = 8;
+pub(super) const SAMPLES_PER_SPAN: usize = 8;
 
 /// Fewest samples accepted.
-pub const MIN_SAMPLES: usize = 4;
+pub(super) const MIN_SAMPLES: usize = 4;
 
 /// Most samples accepted when given: every iteration evaluates its simplex over the samples
 /// of one support, so a run costs about 1 ms per 1000 samples per iteration (20 000 samples
@@ -27,16 +27,16 @@ pub const MIN_SAMPLES: usize = 4;
 pub const MAX_SAMPLES: usize = 20_000;
 
 /// The moving-average half-width is `⌊N / HALF_WIDTH_DIVISOR⌋` (spec §3 step 3.2).
-pub const HALF_WIDTH_DIVISOR: usize = 20;
+pub(super) const HALF_WIDTH_DIVISOR: usize = 20;
 
 /// Passes of the moving average (spec §3 step 3.2).
-pub const DEFAULT_PASSES: usize = 3;
+pub(super) const DEFAULT_PASSES: usize = 3;
 
 /// Coefficients of the B-spline target fit: `max(MIN_TARGET_COEFFICIENTS, ⌊N/20⌋)`.
-pub const MIN_TARGET_COEFFICIENTS: usize = 4;
+pub(super) const MIN_TARGET_COEFFICIENTS: usize = 4;
 
 /// The B-spline target fit samples κ at this many arc-length points per coefficient.
-pub const LOOSE_SAMPLES_PER_COEFFICIENT: usize = 4;
+pub(super) const LOOSE_SAMPLES_PER_COEFFICIENT: usize = 4;
 
 /// How the target curvature g is made from the curvature of the unfaired curve.
 #[derive(Clone, Debug, PartialEq)]
@@ -76,7 +76,8 @@ impl Default for Smoother {
 ///
 /// # Errors
 /// [`Error::Degenerate`] at a parameter where the curvature is undefined (zero speed).
-pub fn sample_curvature(curve: &BSplineCurve, t: &[f64]) -> Result<Vec<f64>> {
+#[cfg(test)]
+pub(super) fn sample_curvature(curve: &BSplineCurve, t: &[f64]) -> Result<Vec<f64>> {
     t.iter()
         .map(|&ti| {
             let k = signed_curvature(&curve.derivatives(ti));
@@ -98,7 +99,7 @@ pub(super) fn zero_speed(t: f64) -> Error {
 /// The normative smoother (spec §3 step 3.2): a centred moving average of half-width h
 /// whose window is truncated at the ends (the mean of the samples that exist), applied
 /// `passes` times. O(N) per pass.
-pub fn moving_average(values: &[f64], half_width: usize, passes: usize) -> Vec<f64> {
+pub(super) fn moving_average(values: &[f64], half_width: usize, passes: usize) -> Vec<f64> {
     let n = values.len();
     let mut cur = values.to_vec();
     let mut prefix = vec![0.0; n + 1];
@@ -119,7 +120,8 @@ pub fn moving_average(values: &[f64], half_width: usize, passes: usize) -> Vec<f
 ///
 /// # Panics
 /// If the lengths differ.
-pub fn target_measure(kappa: &[f64], target: &[f64]) -> f64 {
+#[cfg(test)]
+pub(super) fn target_measure(kappa: &[f64], target: &[f64]) -> f64 {
     assert_eq!(
         kappa.len(),
         target.len(),
@@ -133,7 +135,7 @@ pub fn target_measure(kappa: &[f64], target: &[f64]) -> f64 {
 }
 
 /// The sample count asked for, or the default `max(200, 8 × non-empty spans)`.
-pub fn sample_count(curve: &BSplineCurve, samples: Option<usize>) -> usize {
+pub(super) fn sample_count(curve: &BSplineCurve, samples: Option<usize>) -> usize {
     samples.unwrap_or_else(|| {
         let spans = curve.breakpoints().len().saturating_sub(1);
         DEFAULT_SAMPLES.max(SAMPLES_PER_SPAN * spans)
@@ -147,7 +149,7 @@ pub fn sample_count(curve: &BSplineCurve, samples: Option<usize>) -> usize {
 /// [`Error::LengthMismatch`] for a given target of the wrong length or `kappa` not matching
 /// `t`; [`Error::InvalidParameter`] for a B-spline fit with fewer than 4 coefficients;
 /// [`Error::Degenerate`] for a curve of zero length or zero speed; [`Error::Singular`].
-pub fn target_curvature(
+pub(super) fn target_curvature(
     curve: &BSplineCurve,
     t: &[f64],
     kappa: &[f64],

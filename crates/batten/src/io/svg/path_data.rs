@@ -25,7 +25,7 @@ pub(crate) enum Seg {
 
 impl Seg {
     /// The end point.
-    pub fn end(&self) -> Point {
+    pub(super) fn end(&self) -> Point {
         match self {
             Seg::Line { p, .. } => p[1],
             Seg::Quad { p, .. } => p[2],
@@ -34,7 +34,7 @@ impl Seg {
     }
 
     /// The byte offset of the command in the path data.
-    pub fn at(&self) -> usize {
+    pub(super) fn at(&self) -> usize {
         match self {
             Seg::Line { at, .. } | Seg::Quad { at, .. } | Seg::Cubic { at, .. } => *at,
         }
@@ -42,7 +42,7 @@ impl Seg {
 
     /// The same segment as a cubic Bézier (lines and quadratics degree-elevated exactly up
     /// to rounding: `q₁ = p₀ + 2/3 (p₁ − p₀)`, …).
-    pub fn to_cubic(self) -> [Point; 4] {
+    pub(super) fn to_cubic(self) -> [Point; 4] {
         match self {
             Seg::Line { p, .. } => [
                 p[0],
@@ -61,7 +61,7 @@ impl Seg {
     }
 
     /// The point at parameter `t ∈ [0, 1]` (de Casteljau).
-    pub fn eval(&self, t: f64) -> Point {
+    pub(super) fn eval(&self, t: f64) -> Point {
         match self {
             Seg::Line { p, .. } => p[0].lerp(p[1], t),
             Seg::Quad { p, .. } => p[0].lerp(p[1], t).lerp(p[1].lerp(p[2], t), t),

@@ -8,7 +8,7 @@ use super::{CaseMove, MoveTag, Segment};
 /// A 2×2 system is treated as singular (the move is skipped) when `|det|` is at most this
 /// fraction of `|a11 a22| + |a12 a21|`. The systems of coarse case 3 and fine case 2 have
 /// condition numbers below 30 on sane grids (spec §1.7).
-pub const SINGULAR_REL: f64 = 1e-12;
+pub(super) const SINGULAR_REL: f64 = 1e-12;
 
 impl Segment {
     // --- sign tests --------------------------------------------------------------------------

@@ -1,19 +1,24 @@
 //! Tests of the `han` method (spec §1): every `han.*` test vector, the properties of the unit
 //! responses, each fairing case on a constructed example, the curve pipeline (partition,
 //! strophoid, closed curves) and property tests (tolerance, fixed ends, rigid motions).
+//!
+//! Unit tests (formerly `tests/han.rs`): they reach the paper's case procedures, the unit
+//! responses and the partition, which are not public.
 
 #![allow(clippy::unwrap_used, clippy::needless_range_loop)]
 
 use std::collections::BTreeMap;
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use batten::analysis::{FairnessMetrics, ZERO_REL};
-use batten::fair::han::{
-    self, CaseMove, MoveTag, Procedure, Segment, SegmentParams, UnitResponses,
-};
-use batten::fair::{self, FairOptions, FairStatus};
-use batten::spline::{CubicSplineFn, FnEndCondition};
-use batten::{Error, Point, PointSeq, Rigid, Vec2};
+use super::params::{DEFAULT_FINE_RUN3, DEFAULT_ITERATIONS};
+use super::partition::{Span, partition, turning_angles};
+use super::pipeline::MAX_LOCAL_SLOPE;
+use super::responses::UnitResponses;
+use super::segment::{CaseMove, MoveTag, Procedure, Segment, SegmentParams};
+use crate::analysis::{FairnessMetrics, ZERO_REL};
+use crate::fair::{self, FairOptions, FairStatus};
+use crate::spline::{CubicSplineFn, FnEndCondition};
+use crate::{Error, Point, PointSeq, Rigid, Vec2};
 use proptest::prelude::*;
 use serde_json::Value;
 
@@ -443,7 +448,7 @@ fn sign_runs(c: &[f64]) -> Vec<(usize, usize, i8)> {
     let scale = c.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     let mut runs: Vec<(usize, usize, i8)> = Vec::new();
     for (i, v) in c.iter().enumerate() {
-        let s = batten::analysis::sgn0(*v, scale);
+        let s = crate::analysis::sgn0(*v, scale);
         match runs.last_mut() {
             Some(r) if r.2 == s => r.1 += 1,
             _ => runs.push((i, 1, s)),
@@ -950,7 +955,7 @@ fn vector_partition_strophoid65() {
     let k = v["inputs"]["k"].as_u64().unwrap() as usize;
     let pts = strophoid(count, range[0], range[1]);
     let ex = &v["expected"];
-    let turning = han::turning_angles(&pts).unwrap();
+    let turning = turning_angles(&pts).unwrap();
     check(
         "total turning",
         turning[turning.len() - 1].to_degrees(),
@@ -969,7 +974,7 @@ fn vector_partition_strophoid65() {
             })
             .collect()
     };
-    let spans = han::partition(&pts, PI, k).unwrap();
+    let spans = partition(&pts, PI, k).unwrap();
     let got: Vec<(usize, usize)> = spans.iter().map(|s| (s.start + 1, s.end + 1)).collect();
     assert_eq!(got, as_pairs(&ex["segments_max_turn_pi"]));
     let thetas = arr(&ex["theta_max_turn_pi"]);
@@ -980,7 +985,7 @@ fn vector_partition_strophoid65() {
             s.theta
         );
     }
-    let spans = han::partition(&pts, FRAC_PI_2, k).unwrap();
+    let spans = partition(&pts, FRAC_PI_2, k).unwrap();
     let got: Vec<(usize, usize)> = spans.iter().map(|s| (s.start + 1, s.end + 1)).collect();
     assert_eq!(got, as_pairs(&ex["segments_max_turn_half_pi"]));
 }
@@ -989,7 +994,7 @@ fn vector_partition_strophoid65() {
 fn partition_frames_make_functions() {
     let pts = strophoid(65, -2.0, 2.0);
     for max_turn in [PI, FRAC_PI_2, 1.0] {
-        for s in han::partition(&pts, max_turn, 5).unwrap() {
+        for s in partition(&pts, max_turn, 5).unwrap() {
             let u = Vec2::from_angle(s.theta);
             let xs: Vec<f64> = pts[s.start..=s.end]
                 .iter()
@@ -1001,13 +1006,13 @@ fn partition_frames_make_functions() {
             );
         }
     }
-    assert!(han::partition(&pts, 0.0, 5).is_err());
-    assert!(han::partition(&pts, 4.0, 5).is_err());
-    assert!(han::partition(&pts, PI, 0).is_err());
+    assert!(partition(&pts, 0.0, 5).is_err());
+    assert!(partition(&pts, 4.0, 5).is_err());
+    assert!(partition(&pts, PI, 0).is_err());
     let mut dup = pts.clone();
     dup[3] = dup[2];
     assert_eq!(
-        han::partition(&dup, PI, 5).err(),
+        partition(&dup, PI, 5).err(),
         Some(Error::DuplicatePoint { index: 3 })
     );
 }
@@ -1147,7 +1152,7 @@ fn result_does_not_depend_on_the_number_of_threads() {
         pool.install(|| fair::fair("han", &input, &o).unwrap())
     };
     let (one, four) = (run(1), run(4));
-    assert!(han::partition(input.points(), PI / 4.0, 5).unwrap().len() > 3);
+    assert!(partition(input.points(), PI / 4.0, 5).unwrap().len() > 3);
     assert_eq!(one.points, four.points);
     assert_eq!(one.report.moves.len(), four.report.moves.len());
     for (a, b) in one.report.moves.iter().zip(&four.report.moves) {
@@ -1413,8 +1418,8 @@ fn random_curve(seed: u64, n: usize, closed: bool) -> Vec<Point> {
 }
 
 /// The function segments a pass would fair: span and local (X, Y) as `fair` computes them.
-fn local_segments(pts: &[Point]) -> Vec<(han::Span, Vec<f64>, Vec<f64>)> {
-    han::partition(pts, PI, 5)
+fn local_segments(pts: &[Point]) -> Vec<(Span, Vec<f64>, Vec<f64>)> {
+    partition(pts, PI, 5)
         .unwrap()
         .into_iter()
         .map(|s| {
@@ -1564,23 +1569,23 @@ proptest! {
             // Segments `fair` re-partitions or leaves alone (too steep, see MAX_LOCAL_SLOPE) are
             // not compared.
             let steep = xa.windows(2).zip(ya.windows(2)).any(|(x, y)| {
-                !(x[1] > x[0] && (y[1] - y[0]).abs() <= 0.99 * han::MAX_LOCAL_SLOPE * (x[1] - x[0]))
+                !(x[1] > x[0] && (y[1] - y[0]).abs() <= 0.99 * MAX_LOCAL_SLOPE * (x[1] - x[0]))
             });
             if steep {
                 all_same = false;
                 continue;
             }
             // The method's segment parameters (fine case 3 on).
-            let method = SegmentParams::DEFAULT.with_fine_run3(han::DEFAULT_FINE_RUN3);
+            let method = SegmentParams::DEFAULT.with_fine_run3(DEFAULT_FINE_RUN3);
             // With the floors `fair` uses: those of each input's coordinate magnitude.
             let seg = |x, y, pts: &[Point]| {
-                let coord = batten::geom::max_abs_coordinate(pts);
+                let coord = crate::geom::max_abs_coordinate(pts);
                 Segment::new(x, y)
                     .and_then(|s| s.with_params(method))
                     .map(|s| s.with_coordinate_scale(coord))
             };
             if let (Ok(a), Ok(b)) = (seg(xa, ya, &pts), seg(xb, yb, &moved)) {
-                match same_run(a, b, han::DEFAULT_ITERATIONS, scale) {
+                match same_run(a, b, DEFAULT_ITERATIONS, scale) {
                     Ok(same) => all_same &= same,
                     Err(e) => prop_assert!(false, "{}", e),
                 }

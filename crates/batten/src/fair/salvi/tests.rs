@@ -1,22 +1,47 @@
 //! Salvi & Várady target-curvature fairing and Eck & Hadenfeld local energy fairing
 //! (spec §3): the `salvi_varady` test vectors, the properties of `sv.fair.properties`, and
 //! the behaviour of both methods on B-spline and point input.
+//!
+//! Unit tests (formerly `tests/salvi.rs`): they reach the target curvature and the shared
+//! local-fairing machinery of `fair/local.rs`, which are not public.
 
-use batten::fair::eck_hadenfeld::{self, EckHadenfeldParams};
-use batten::fair::local::{
+use crate::fair::eck_hadenfeld::{self, EckHadenfeldParams};
+use crate::fair::local::{
     RecentList, clamp_to_original, principal_curvatures, support_ranges, uniform_samples,
 };
-use batten::fair::salvi::{self, SalviParams, Smoother};
-use batten::fair::{self, FairStatus};
-use batten::spline::{BSplineCurve, KnotVector};
-use batten::{Curve, Error, FairOptions, Point, PointSeq};
+use crate::fair::salvi::target::{
+    moving_average, sample_curvature, target_curvature, target_measure,
+};
+use crate::fair::salvi::{self, SalviParams, Smoother};
+use crate::fair::{self, FairStatus};
+use crate::spline::{BSplineCurve, KnotVector};
+use crate::{Curve, Error, FairOptions, Point, PointSeq};
 use proptest::prelude::*;
 use serde_json::Value;
 
-mod common;
-use common::Rng;
+const VECTORS: &str = include_str!("../../../tests/data/test-vectors.json");
 
-const VECTORS: &str = include_str!("data/test-vectors.json");
+/// The seeded xorshift of `tests/common` (shifts 13, 7, 17), for the same noise.
+struct Rng(u64);
+
+impl Rng {
+    fn new(seed: u64) -> Rng {
+        Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+    }
+
+    fn uniform(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// A standard normal sample: Box–Muller on two uniform samples.
+    fn gaussian(&mut self) -> f64 {
+        let (a, b) = (self.uniform(), self.uniform());
+        (-2.0 * a.max(1e-300).ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+    }
+}
 
 fn vector(id: &str) -> Value {
     let all: Value = serde_json::from_str(VECTORS).expect("test-vectors.json parses");
@@ -133,7 +158,7 @@ fn rms_difference(a: &[f64], b: &[f64]) -> f64 {
     (a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>() / a.len() as f64).sqrt()
 }
 
-fn non_increasing(history: &[batten::fair::HistoryRow]) -> bool {
+fn non_increasing(history: &[crate::fair::HistoryRow]) -> bool {
     history.windows(2).all(|w| w[1].measure <= w[0].measure)
 }
 
@@ -151,7 +176,7 @@ fn vector_curvature_samples() {
         None,
     )
     .expect("curve");
-    let kappa = salvi::sample_curvature(&curve, &floats(&inp["t"])).expect("curvature");
+    let kappa = sample_curvature(&curve, &floats(&inp["t"])).expect("curvature");
     assert_close(
         &kappa,
         &floats(&v["expected"]["kappa"]),
@@ -166,18 +191,18 @@ fn vector_target_smoothing() {
     let kappa = floats(&v["inputs"]["kappa"]);
     let exp = &v["expected"];
     let tol = &v["tolerance"];
-    let g1 = salvi::moving_average(&kappa, 1, 1);
+    let g1 = moving_average(&kappa, 1, 1);
     assert_close(&g1, &floats(&exp["h1_passes1"]), tol, "h1_passes1");
-    let g2 = salvi::moving_average(&kappa, 2, 3);
+    let g2 = moving_average(&kappa, 2, 3);
     assert_close(&g2, &floats(&exp["h2_passes3"]), tol, "h2_passes3");
-    let m = salvi::target_measure(&kappa, &g1);
+    let m = target_measure(&kappa, &g1);
     // The stored measure has 12 significant digits.
     assert!((m - exp["measure_h1_passes1"].as_f64().expect("measure")).abs() < 1e-10);
     // The same smoother through the method's entry point (N = 10 gives h = ⌊10/20⌋ = 0, so the
     // half-width is given).
     let curve = sine_base();
     let t = uniform_samples(curve.domain(), kappa.len());
-    let g = salvi::target_curvature(
+    let g = target_curvature(
         &curve,
         &t,
         &kappa,
@@ -259,7 +284,7 @@ fn vector_principal_curvatures_paraboloid() {
         )
         .expect("basis curve");
         let span = c.find_span(t);
-        let mut b = [[0.0; batten::spline::MAX_ORDER]; 4];
+        let mut b = [[0.0; crate::spline::MAX_ORDER]; 4];
         c.basis_derivs(span, t, 2, &mut b);
         (span - 3, b)
     };
@@ -335,7 +360,7 @@ fn fair_properties() {
         assert!(local.max_control_displacement <= 0.2 * (1.0 + 1e-12));
         assert!(max_deviation(&faired, &noisy) <= 0.2 * (1.0 + 1e-12));
         assert!(r.max_curve_deviation <= 0.2 * (1.0 + 1e-12));
-        let truth = salvi::sample_curvature(&base, &r.samples).expect("curvature");
+        let truth = sample_curvature(&base, &r.samples).expect("curvature");
         let before = rms_difference(&r.curvature_before, &truth);
         let after = rms_difference(&r.curvature_after, &truth);
         assert!(
@@ -352,8 +377,8 @@ fn local_updates_agree_with_a_full_evaluation() {
     let noisy = perturbed(&sine_base(), 0.03, 11);
     let (faired, r) =
         salvi::fair_curve(&noisy, &SalviParams::DEFAULT.with_tolerance(0.2)).expect("fair");
-    let kappa = salvi::sample_curvature(&faired, &r.samples).expect("curvature");
-    let full = salvi::target_measure(&kappa, &r.target);
+    let kappa = sample_curvature(&faired, &r.samples).expect("curvature");
+    let full = target_measure(&kappa, &r.target);
     assert!((full - r.local.measure_after).abs() <= 1e-9 * full);
     let last = r.local.history.last().expect("history").measure;
     assert!((full - last).abs() <= 1e-9 * full);
@@ -433,8 +458,8 @@ fn knots_degree_and_weights_are_preserved() {
     assert!(non_increasing(&r.local.history) && r.local.measure_after < r.local.measure_before);
     assert!(non_increasing(&re.history) && re.measure_after < re.measure_before);
     // The rational bookkeeping agrees with a full evaluation too.
-    let k = salvi::sample_curvature(&s, &r.samples).expect("curvature");
-    let full = salvi::target_measure(&k, &r.target);
+    let k = sample_curvature(&s, &r.samples).expect("curvature");
+    let full = target_measure(&k, &r.target);
     assert!((full - r.local.measure_after).abs() <= 1e-9 * full);
 }
 
@@ -552,15 +577,15 @@ fn salvi_window_rule_and_stall_rule_stop_the_run() {
 fn targets_pinned_fitted_and_given() {
     let noisy = perturbed(&sine_base(), 0.03, 8);
     let t = uniform_samples(noisy.domain(), 200);
-    let kappa = salvi::sample_curvature(&noisy, &t).expect("curvature");
+    let kappa = sample_curvature(&noisy, &t).expect("curvature");
     for smoother in [
         Smoother::DEFAULT,
         Smoother::BSplineFit { coefficients: None },
     ] {
-        let g = salvi::target_curvature(&noisy, &t, &kappa, &smoother, true).expect("target");
+        let g = target_curvature(&noisy, &t, &kappa, &smoother, true).expect("target");
         assert_eq!(g[0], kappa[0]);
         assert_eq!(g[199], kappa[199]);
-        let free = salvi::target_curvature(&noisy, &t, &kappa, &smoother, false).expect("target");
+        let free = target_curvature(&noisy, &t, &kappa, &smoother, false).expect("target");
         // Away from the ends the pin changes nothing.
         assert_eq!(g[100], free[100]);
         // The target is smoother than the data: smaller second differences.
@@ -583,7 +608,7 @@ fn targets_pinned_fitted_and_given() {
     }
     // The true curvature as a given target ("manual editing") brings the curvature closer
     // to it than the moving average does.
-    let truth = salvi::sample_curvature(&sine_base(), &t).expect("curvature");
+    let truth = sample_curvature(&sine_base(), &t).expect("curvature");
     let params = SalviParams::DEFAULT.with_tolerance(0.2).with_samples(200);
     let (_, given) = salvi::fair_curve(
         &noisy,
@@ -656,7 +681,7 @@ fn degenerate_and_invalid_input() {
 
 #[test]
 fn recent_list_capacity_four_by_default() {
-    assert_eq!(batten::fair::local::DEFAULT_TABU_LENGTH, 4);
+    assert_eq!(crate::fair::local::DEFAULT_TABU_LENGTH, 4);
     let mut l = RecentList::new(SalviParams::DEFAULT.tabu_length);
     for j in 0..6 {
         l.push(j);

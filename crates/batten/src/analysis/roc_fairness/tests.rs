@@ -2,17 +2,21 @@
 //! specification, the shape modification, the fairness evaluation and the `kuragano` method,
 //! against the "kuragano" vectors of `tests/data/test-vectors.json` (format: spec §7) and the
 //! properties the spec states.
+//!
+//! Unit tests (formerly `tests/kuragano.rs`): they reach the specification's steps
+//! ([`sample_rho`], [`RhoFit`], [`modify_shape`], [`rho_gradient`]), which are not public.
 
-use batten::curve::{Curve, CurveDeriv};
-use batten::fair::kuragano::{
-    self, DegreeResult, DesignEnds, KuraganoOptions, Residual, RhoFit, ShapeConstraints,
-    StopReason, TIE_TOLERANCE, angle_degrees, cosine, modify_shape, rho_gradient, sample_rho,
-    truncate_angle,
-};
-use batten::spline::BSplineCurve;
-use batten::spline::quintic::{self, Ends, QuinticForm};
-use batten::{FairOptions, Point, PointSeq, Vec2, fair};
 use serde_json::Value;
+
+use super::evaluate::{PAPER_TIE_TOLERANCE, cosine, select_best_within};
+use super::modify::rho_gradient;
+use super::samples::sample_rho;
+use super::*;
+use crate::curve::{Curve, CurveDeriv};
+use crate::fair::{self, FairOptions};
+use crate::geom::{Point, PointSeq, Vec2};
+use crate::spline::BSplineCurve;
+use crate::spline::quintic::{self, Ends, QuinticForm};
 
 fn vector(id: &str) -> Value {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/test-vectors.json");
@@ -50,135 +54,6 @@ fn close(got: f64, exp: f64, tol: &Value, what: &str) {
         (got - exp).abs() <= abs + rel * exp.abs(),
         "{what}: got {got:e}, expected {exp:e}"
     );
-}
-
-/// A curve with six control points on the knots −5..6: its only segment is the paper's eq 3.
-fn one_segment() -> BSplineCurve {
-    let q = (0..6)
-        .map(|i| Point::new(i as f64, (i * i) as f64))
-        .collect();
-    quintic::from_control_points(q, QuinticForm::BSpline).expect("curve")
-}
-
-#[test]
-fn ky_basis_rows_follow_from_the_basis() {
-    let v = vector("ky.basis.rows");
-    let tol = &v["tolerance"];
-    let c = one_segment();
-    let mut b = [[0.0; batten::spline::MAX_ORDER]; 4];
-    c.basis_derivs(c.find_span(0.0), 0.0, 3, &mut b);
-    // r = 4: N''' of a segment is a quadratic in t, so its derivative at 0 is exactly
-    // (−3 f(0) + 4 f(h) − f(2h)) / 2h (up to rounding).
-    let h = 0.25;
-    let third = |t: f64| {
-        let mut o = [[0.0; batten::spline::MAX_ORDER]; 4];
-        c.basis_derivs(c.find_span(t), t, 3, &mut o);
-        o[3]
-    };
-    let (f0, f1, f2) = (third(0.0), third(h), third(2.0 * h));
-    let derived: Vec<Vec<f64>> = (0..=4)
-        .map(|r| {
-            (0..6)
-                .map(|j| {
-                    if r <= 3 {
-                        b[r][j]
-                    } else {
-                        (-3.0 * f0[j] + 4.0 * f1[j] - f2[j]) / (2.0 * h)
-                    }
-                })
-                .collect()
-        })
-        .collect();
-    for (r, row) in derived.iter().enumerate() {
-        // The coefficient of q_{i+5} is zero for r ≤ 4.
-        assert!(row[5].abs() < 1e-12, "r={r}");
-        // The named stencils agree with de Boor–Cox (Piegl & Tiller A2.3).
-        let t = if r <= 3 { 1e-15 } else { 1e-12 };
-        for j in 0..5 {
-            assert!((row[j] - quintic::ROWS[r][j]).abs() < t, "r={r} j={j}");
-        }
-        // Polynomial reproduction: for q_j = j^k the curve is a degree-k polynomial in u with
-        // leading coefficient 1, so d^r R/du^r = r! when k = r and 0 when k < r.
-        for k in 0..=r {
-            let moment: f64 = (0..5)
-                .map(|j| quintic::ROWS[r][j] * (j as f64).powi(k as i32))
-                .sum();
-            let expected = if k == r {
-                (1..=r).product::<usize>() as f64
-            } else {
-                0.0
-            };
-            assert!((moment - expected).abs() < 1e-12, "r={r} k={k}: {moment}");
-        }
-    }
-    // The vector: rows 0, 1 (eq 8, eq 9), 2 and 4 as given.
-    for r in [0, 1, 2, 4] {
-        for (j, &e) in nums(&v["expected"][format!("r{r}")]).iter().enumerate() {
-            close(quintic::ROWS[r][j], e, tol, &format!("ROWS[{r}][{j}]"));
-        }
-    }
-    // Row 3 of the vector (and of the spec table) has the signs of q_{i+1} and q_{i+3}
-    // swapped: it fails the reproduction test above (q_j = j³ gives 58, not 6), so the
-    // derived row is asserted and the vector's row only up to those two signs.
-    let r3 = nums(&v["expected"]["r3"]);
-    for (j, &e) in r3.iter().enumerate() {
-        let sign = if j == 1 || j == 3 { -1.0 } else { 1.0 };
-        close(quintic::ROWS[3][j], sign * e, tol, &format!("ROWS[3][{j}]"));
-    }
-}
-
-#[test]
-fn ky_basis_values_t0_3() {
-    let v = vector("ky.basis.values_t0_3");
-    let tol = &v["tolerance"];
-    let t = num(&v["inputs"]["t"]);
-    let c = one_segment();
-    let mut b = [[0.0; batten::spline::MAX_ORDER]; 4];
-    c.basis_derivs(c.find_span(t), t, 2, &mut b);
-    let closed_form = quintic::basis(t);
-    for (r, key) in ["N", "dN", "d2N"].iter().enumerate() {
-        for (j, &e) in nums(&v["expected"][*key]).iter().enumerate() {
-            close(b[r][j], e, tol, &format!("basis_derivs {key}[{j}]"));
-            close(
-                closed_form[r][j],
-                e,
-                tol,
-                &format!("quintic::basis {key}[{j}]"),
-            );
-        }
-    }
-}
-
-#[test]
-fn ky_interpolate_natural_ends() {
-    let v = vector("ky.interpolate.natural_ends");
-    let tol = &v["tolerance"];
-    let pts = points(&v["inputs"]["points"]);
-    let c = quintic::interpolate(&pts, &Ends::Natural, QuinticForm::Nurbs).expect("interpolant");
-    let exp = points(&v["expected"]["control_points"]);
-    assert_eq!(c.control_points().len(), exp.len());
-    for (j, (q, e)) in c.control_points().iter().zip(&exp).enumerate() {
-        close(q.x, e.x, tol, &format!("q[{j}].x"));
-        close(q.y, e.y, tol, &format!("q[{j}].y"));
-    }
-    // NURBS form with unit weights; passes through the points at u = i.
-    assert!(c.weights().is_some_and(|w| w.iter().all(|&x| x == 1.0)));
-    for (i, p) in pts.iter().enumerate() {
-        assert!((c.eval(i as f64) - *p).length() < 1e-12);
-    }
-    // R'' = 0 and R'''' = 0 at both ends (rows 2 and 4 on q_0..q_4 and q_{m−1}..q_{m+3}).
-    let q = c.control_points();
-    let m = pts.len();
-    for start in [0, m - 1] {
-        for r in [2, 4] {
-            let v: Vec2 = (0..5).fold(Vec2::ZERO, |a, k| {
-                a + q[start + k].to_vec2() * quintic::ROWS[r][k]
-            });
-            assert!(v.length() < 1e-12, "row {r} at {start}");
-        }
-    }
-    assert!(c.derivatives(0.0).d2.length() < 1e-12);
-    assert!(c.derivatives((m - 1) as f64).d2.length() < 1e-12);
 }
 
 /// The curve of `ky.interpolate.gradients_and_rho_fit` and its inputs.
@@ -266,7 +141,7 @@ fn ky_shape_modification_properties() {
             &s,
             &spec,
             Residual::Rho,
-            kuragano::DEFAULT_MAX_ITERATIONS,
+            DEFAULT_MAX_ITERATIONS,
             &ShapeConstraints::default(),
         )
         .expect("modification");
@@ -322,7 +197,7 @@ fn curvature_residual_variant_converges_too() {
             &s,
             &spec,
             Residual::Kappa,
-            kuragano::DEFAULT_MAX_ITERATIONS,
+            DEFAULT_MAX_ITERATIONS,
             &ShapeConstraints::default(),
         )
         .expect("modification");
@@ -410,8 +285,7 @@ fn ky_fairness_cos_to_degrees() {
             .collect();
         // The paper breaks ties at its printed precision (curve B: quintic 1.56° against
         // quartic 1.58°, cosines 1e-5 apart); batten's default TIE_TOLERANCE would say quartic.
-        let best = kuragano::select_best_within(&rows, kuragano::PAPER_TIE_TOLERANCE)
-            .expect("a selection");
+        let best = select_best_within(&rows, PAPER_TIE_TOLERANCE).expect("a selection");
         assert_eq!(
             names[best.degree - 1],
             exp["selected"][*curve].as_str().expect("name"),
@@ -451,7 +325,7 @@ fn logarithmic_spiral_evaluates_as_linear() {
     let (pts, grads) = log_spiral(25, 0.2, 4.0);
     let c = quintic::interpolate(&pts, &Ends::Gradients(grads), QuinticForm::BSpline)
         .expect("interpolant");
-    let e = kuragano::evaluate(&c, &KuraganoOptions::default()).expect("evaluation");
+    let e = evaluate(&c, &KuraganoOptions::default()).expect("evaluation");
     assert_eq!(e.best_degree, Some(1));
     assert!(e.fairness.is_some_and(|f| f > 0.9999));
     assert!(e.degrees.iter().all(|d| d.applicable));
@@ -469,7 +343,7 @@ fn logarithmic_spiral_evaluates_as_linear() {
         .map(|p| Point::new(p.x, -p.y))
         .collect();
     let cm = c.with_control_points(mirrored).expect("curve");
-    let em = kuragano::evaluate(&cm, &KuraganoOptions::default()).expect("evaluation");
+    let em = evaluate(&cm, &KuraganoOptions::default()).expect("evaluation");
     assert_eq!(em.best_degree, Some(1));
 }
 
@@ -478,7 +352,7 @@ fn evaluation_json_shape() {
     let (pts, grads) = log_spiral(12, 0.2, 3.0);
     let c = quintic::interpolate(&pts, &Ends::Gradients(grads), QuinticForm::BSpline)
         .expect("interpolant");
-    let e = kuragano::evaluate(&c, &KuraganoOptions::default()).expect("evaluation");
+    let e = evaluate(&c, &KuraganoOptions::default()).expect("evaluation");
     let j = serde_json::to_value(&e).expect("json");
     let obj = j.as_object().expect("object");
     let mut keys: Vec<&str> = obj.keys().map(String::as_str).collect();
@@ -500,7 +374,7 @@ fn inflection_and_straight_designs_are_not_applicable() {
             Point::new(x, (x * 0.8).sin())
         })
         .collect();
-    let e = kuragano::evaluate(&s_curve, &KuraganoOptions::default()).expect("evaluation");
+    let e = evaluate(&s_curve, &KuraganoOptions::default()).expect("evaluation");
     assert_eq!(e.best_degree, None);
     assert_eq!(e.fairness, None);
     assert!(
@@ -514,14 +388,14 @@ fn inflection_and_straight_designs_are_not_applicable() {
     let line: Vec<Point> = (0..8)
         .map(|i| Point::new(i as f64, 0.5 * i as f64))
         .collect();
-    let e = kuragano::evaluate(&line, &KuraganoOptions::default()).expect("evaluation");
+    let e = evaluate(&line, &KuraganoOptions::default()).expect("evaluation");
     assert_eq!(e.best_degree, None);
     // The method leaves both unchanged with degree auto.
     for pts in [s_curve, line] {
         let seq = PointSeq::open(pts.clone()).expect("points");
         let out = fair::fair("kuragano", &seq, &FairOptions::default()).expect("fair");
         assert_eq!(out.points, pts);
-        assert_eq!(out.report.status, batten::fair::FairStatus::NoChange);
+        assert_eq!(out.report.status, fair::FairStatus::NoChange);
     }
 }
 
@@ -618,12 +492,7 @@ fn method_fairs_through_spurious_inflections_with_an_explicit_degree() {
     let pts = noisy_spiral(25, 1e-3);
     let opts = KuraganoOptions::default();
     // The noisy design has inflections: the evaluation finds no applicable degree.
-    assert_eq!(
-        kuragano::evaluate(&pts, &opts)
-            .expect("evaluation")
-            .best_degree,
-        None
-    );
+    assert_eq!(evaluate(&pts, &opts).expect("evaluation").best_degree, None);
     let seq = PointSeq::open(pts).expect("points");
     let out = fair::fair(
         "kuragano",
@@ -674,7 +543,7 @@ fn natural_ends_design_option() {
     let opts = KuraganoOptions::default()
         .with_ends(DesignEnds::Natural)
         .with_samples(41);
-    let e = kuragano::evaluate(&pts, &opts).expect("evaluation");
+    let e = evaluate(&pts, &opts).expect("evaluation");
     assert_eq!(e.degrees.len(), 6);
 }
 
@@ -717,7 +586,7 @@ fn curve_with_rho(rho: impl Fn(f64) -> f64, length: f64, n: usize) -> Vec<Point>
 fn exact_log_spiral_points_evaluate_as_linear() {
     for (n, length) in [(41, 6.0), (60, 10.0)] {
         let pts = curve_with_rho(|s| 1.0 + 0.5 * s, length, n);
-        let e = kuragano::evaluate(&pts, &KuraganoOptions::default()).expect("evaluation");
+        let e = evaluate(&pts, &KuraganoOptions::default()).expect("evaluation");
         assert_eq!(e.best_degree, Some(1), "n = {n}: {:?}", e.degrees);
         // Not by luck of a 1e-6 tie: some higher degree had a larger cosine.
         let max = e
@@ -735,7 +604,7 @@ fn exact_log_spiral_points_evaluate_as_linear() {
             Point::new(r * t.cos(), r * t.sin())
         })
         .collect();
-    let e = kuragano::evaluate(&pts, &KuraganoOptions::default()).expect("evaluation");
+    let e = evaluate(&pts, &KuraganoOptions::default()).expect("evaluation");
     assert_eq!(e.best_degree, Some(1), "{:?}", e.degrees);
 }
 
@@ -749,7 +618,7 @@ fn quadratic_rho_evaluates_as_quadratic() {
         |s| 1.0 + 0.5 * (s - 3.0) * (s - 3.0),
     ] {
         let pts = curve_with_rho(rho, 6.0, 41);
-        let e = kuragano::evaluate(&pts, &KuraganoOptions::default()).expect("evaluation");
+        let e = evaluate(&pts, &KuraganoOptions::default()).expect("evaluation");
         assert_eq!(e.best_degree, Some(2), "{:?}", e.degrees);
         let lin = e.degrees[0].correlation.expect("degree 1 applies");
         assert!(lin < e.fairness.expect("fairness") - 10.0 * TIE_TOLERANCE);
