@@ -4,10 +4,10 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::anyhow;
-use batten::fair::{self, FairReport, FairStatus};
+use batten::fair::{self, FairMethod, FairReport, FairStatus};
 use batten::io::{self, Format, IoError, PointData, format_f64};
 use batten::spline::BSplineCurve;
-use batten::{Faired, PointSeq, analysis};
+use batten::{FairOptions, Faired, PointSeq, Vec2, analysis};
 
 use crate::FairArgs;
 use crate::failure::{EXIT_FAILED, Failure};
@@ -24,20 +24,7 @@ const DIGITS: usize = 4;
 /// # Errors
 /// Usage errors (exit 2); a method failure or a failed write (exit 1).
 pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
-    let name = args
-        .how
-        .method
-        .as_deref()
-        .unwrap_or_else(|| fair::default_method());
-    let method = input::method(name)?;
-    let params = input::parse_sets(&args.how.set)?;
-    let options = input::options(
-        args.bounds.tolerance,
-        args.bounds.fix_ends.unwrap_or_default(),
-        args.how.max_iterations,
-        params,
-    );
-    input::check(method, args.closed, &options)?;
+    let (method, options) = method_options(args)?;
     let in_format = formats::format_of(&args.input, args.pick.format)?;
     let out_format = formats::format_of(&args.output, args.pick.format)?;
     let input_name = formats::display_name(&args.input);
@@ -52,33 +39,7 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
     }
     let curve_format = match &args.curve_out {
         None => None,
-        Some(curve_out) => {
-            let f = Format::from_path(curve_out)
-                .ok()
-                .filter(|f| *f != Format::Text);
-            let Some(f) = f else {
-                return Err(Failure::usage(anyhow!(
-                    "{}: --curve-out writes a B-spline: give a .json, .dxf, .igs or .svg file",
-                    curve_out.display()
-                )));
-            };
-            check_writable(curve_out)?;
-            if !formats::is_stdio(&args.input) {
-                io::ensure_distinct(&args.input, curve_out).map_err(Failure::usage)?;
-            }
-            let clash = same_path(curve_out, &args.output)
-                || args
-                    .report
-                    .as_deref()
-                    .is_some_and(|r| same_path(curve_out, r));
-            if clash {
-                return Err(Failure::usage(anyhow!(
-                    "--curve-out {} names another output too",
-                    curve_out.display()
-                )));
-            }
-            Some(f)
-        }
+        Some(curve_out) => Some(check_curve_out(args, curve_out)?),
     };
 
     // A B-spline (JSON, DXF SPLINE, IGES 126, SVG Béziers) is faired as a curve
@@ -97,27 +58,7 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
             return crate::fair_space_cmd::run(args, method, &options, &d, &origin, out_format);
         }
     };
-    match &source {
-        // A JSON file can make the curve closed: check the method against that too.
-        Source::Points(d) => fair::check_options(method, d.seq.is_closed(), &options)
-            .map_err(|e| Failure::from_batten(&input_name.display().to_string(), e))?,
-        Source::Curve(_) if !method.run_curve_supported() => {
-            return Err(Failure::usage(anyhow!(
-                "{}; method {} takes points (B-spline input: {})",
-                IoError::CurveNotPoints {
-                    path: input_name.clone()
-                },
-                method.name(),
-                fair::methods()
-                    .iter()
-                    .filter(|m| m.run_curve_supported())
-                    .map(|m| m.name())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )));
-        }
-        Source::Curve(_) => {}
-    }
+    check_source(&source, method, &options, &input_name)?;
     check_distinct(args, to_stdout)?;
 
     let input_name = input_name.display();
@@ -140,21 +81,7 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         .as_deref()
         .or(data.and_then(|d| d.tangents.as_deref()));
     let out_name = formats::display_name(&args.output);
-    let bytes = match (out_format, faired.curve.as_ref()) {
-        // SVG holds the faired B-spline itself when it can (a method's cubic).
-        (Format::Svg, Some(c)) if io::svg_can_hold(c) => {
-            io::format_curve(out_format, &out_name, c, closed, &origin)
-        }
-        _ => io::format_points(
-            out_format,
-            &out_name,
-            &faired.points,
-            closed,
-            tangents,
-            &origin,
-        ),
-    }
-    .map_err(Failure::failed)?;
+    let bytes = output_bytes(out_format, &out_name, &faired, closed, tangents, &origin)?;
     // One set, all or none: the report and the curve first, the points last, so that a
     // faired file beside an older report cannot happen (see `io::write_atomic_set`). Points
     // for standard output go there once the files are written.
@@ -178,6 +105,119 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
     let figures = figures(&faired.report);
     output::note(&summary_line(&figures, data.map(|d| d.lines.as_slice())));
     Ok(verdict(&figures, args.report.is_some()))
+}
+
+/// The method and the options of `batten fair`, checked against each other.
+///
+/// # Errors
+/// [`Failure::usage`]: an unknown method, a malformed or unknown `--set`, an option the
+/// method does not take.
+fn method_options(args: &FairArgs) -> Result<(&'static dyn FairMethod, FairOptions), Failure> {
+    let name = args
+        .how
+        .method
+        .as_deref()
+        .unwrap_or_else(|| fair::default_method());
+    let method = input::method(name)?;
+    let params = input::parse_sets(&args.how.set)?;
+    let options = input::options(
+        args.bounds.tolerance,
+        args.bounds.fix_ends.unwrap_or_default(),
+        args.how.max_iterations,
+        params,
+    );
+    input::check(method, args.closed, &options)?;
+    Ok((method, options))
+}
+
+/// The format of `--curve-out`, once it is known to take a B-spline, to be writable, and to
+/// name neither the input nor another output.
+///
+/// # Errors
+/// [`Failure::usage`] naming the file and what is wrong with it.
+fn check_curve_out(args: &FairArgs, curve_out: &Path) -> Result<Format, Failure> {
+    let f = Format::from_path(curve_out)
+        .ok()
+        .filter(|f| *f != Format::Text);
+    let Some(f) = f else {
+        return Err(Failure::usage(anyhow!(
+            "{}: --curve-out writes a B-spline: give a .json, .dxf, .igs or .svg file",
+            curve_out.display()
+        )));
+    };
+    check_writable(curve_out)?;
+    if !formats::is_stdio(&args.input) {
+        io::ensure_distinct(&args.input, curve_out).map_err(Failure::usage)?;
+    }
+    let clash = same_path(curve_out, &args.output)
+        || args
+            .report
+            .as_deref()
+            .is_some_and(|r| same_path(curve_out, r));
+    if clash {
+        return Err(Failure::usage(anyhow!(
+            "--curve-out {} names another output too",
+            curve_out.display()
+        )));
+    }
+    Ok(f)
+}
+
+/// Check what was read against the method: points against its options again (a JSON file
+/// can make the curve closed), a B-spline against the methods that take one.
+///
+/// # Errors
+/// [`Failure::usage`] naming the input (`input_name`).
+fn check_source(
+    source: &Source,
+    method: &dyn FairMethod,
+    options: &FairOptions,
+    input_name: &Path,
+) -> Result<(), Failure> {
+    match source {
+        // A JSON file can make the curve closed: check the method against that too.
+        Source::Points(d) => fair::check_options(method, d.seq.is_closed(), options)
+            .map_err(|e| Failure::from_batten(&input_name.display().to_string(), e))?,
+        Source::Curve(_) if !method.run_curve_supported() => {
+            return Err(Failure::usage(anyhow!(
+                "{}; method {} takes points (B-spline input: {})",
+                IoError::CurveNotPoints {
+                    path: input_name.to_path_buf()
+                },
+                method.name(),
+                fair::methods()
+                    .iter()
+                    .filter(|m| m.run_curve_supported())
+                    .map(|m| m.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )));
+        }
+        Source::Curve(_) => {}
+    }
+    Ok(())
+}
+
+/// The faired points, encoded as `format` for the output named `out_name`.
+///
+/// # Errors
+/// [`Failure::failed`] when the points cannot be encoded.
+fn output_bytes(
+    format: Format,
+    out_name: &Path,
+    faired: &Faired,
+    closed: bool,
+    tangents: Option<&[Vec2]>,
+    origin: &io::Origin,
+) -> Result<Vec<u8>, Failure> {
+    match (format, faired.curve.as_ref()) {
+        // SVG holds the faired B-spline itself when it can (a method's cubic).
+        (Format::Svg, Some(c)) if io::svg_can_hold(c) => {
+            io::format_curve(format, out_name, c, closed, origin)
+        }
+        _ => io::format_points(format, out_name, &faired.points, closed, tangents, origin),
+    }
+    .map_err(Failure::failed)
 }
 
 /// Write the report, the curve and the points as one set, all or none, the points last (see

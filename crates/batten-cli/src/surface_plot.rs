@@ -8,8 +8,8 @@ use std::process::ExitCode;
 use anyhow::anyhow;
 use batten::io;
 use batten::surface::{
-    BSplineSurface, Camera, Field, Palette, Shading, SurfaceMesh, Xyz, isophote_range, render,
-    zebra_range,
+    BSplineSurface, Camera, Field, Palette, SampleGrid, Shading, SurfaceMesh, Xyz, isophote_range,
+    render, zebra_range,
 };
 use clap::{Args, ValueEnum};
 
@@ -252,93 +252,12 @@ pub(crate) fn figure(
             SurfaceKind::Gaussian
             | SurfaceKind::Mean
             | SurfaceKind::Kappa1
-            | SurfaceKind::Kappa2 => {
-                let field = match kind {
-                    SurfaceKind::Gaussian => Field::Gaussian,
-                    SurfaceKind::Mean => Field::Mean,
-                    SurfaceKind::Kappa1 => Field::Kappa1,
-                    _ => Field::Kappa2,
-                };
-                let mut m = 0.0f64;
-                for mesh in &mut meshes {
-                    mesh.set_field(field);
-                    if let Some((lo, hi)) = mesh.value_range() {
-                        m = m.max(lo.abs()).max(hi.abs());
-                    }
-                }
-                if m == 0.0 {
-                    // A plane: any symmetric range draws it white.
-                    m = 1.0;
-                }
-                let shading = Shading::Map {
-                    lo: -m,
-                    hi: m,
-                    palette: Palette::Diverging,
-                };
-                Row {
-                    title,
-                    panels: meshes
-                        .iter()
-                        .map(|x| render(x, &camera, &shading))
-                        .collect(),
-                    bar: Some(Bar {
-                        lo: -m,
-                        hi: m,
-                        palette: Palette::Diverging,
-                    }),
-                }
-            }
+            | SurfaceKind::Kappa2 => curvature_row(kind, title, &mut meshes, &camera),
             SurfaceKind::Isophotes | SurfaceKind::Zebra => {
-                // Bands over the range seen on both panels, so a gently curved hood shows
-                // as many as a ball and before and after share them.
-                let shading = if kind == SurfaceKind::Isophotes {
-                    let light = v.light.unwrap_or(v.view);
-                    let (lo, hi) =
-                        isophote_range(&meshes.iter().collect::<Vec<_>>(), &camera, light);
-                    Shading::Isophotes {
-                        light,
-                        lo,
-                        hi,
-                        bands: usize::from(v.stripes),
-                    }
-                } else {
-                    let (lo, hi) = zebra_range(&meshes.iter().collect::<Vec<_>>(), &camera);
-                    Shading::Zebra {
-                        lo,
-                        hi,
-                        stripes: usize::from(v.stripes),
-                    }
-                };
-                Row {
-                    title,
-                    panels: meshes
-                        .iter()
-                        .map(|x| render(x, &camera, &shading))
-                        .collect(),
-                    bar: None,
-                }
+                stripes_row(kind, title, &meshes, &camera, v)
             }
             SurfaceKind::Deviation | SurfaceKind::All => {
-                let Some(mesh) = meshes.get_mut(1) else {
-                    return Err(Failure::usage(anyhow!("--kind deviation needs --faired")));
-                };
-                mesh.set_deviation(before, &grid)
-                    .map_err(|e| Failure::from_batten("", e))?;
-                let hi = mesh.value_range().map_or(0.0, |r| r.1);
-                let shading = Shading::Map {
-                    lo: 0.0,
-                    hi,
-                    palette: Palette::Sequential,
-                };
-                Row {
-                    title: format!("{name}: distance to the faired surface, on the faired one"),
-                    panels: vec![render(mesh, &camera, &shading)],
-                    bar: Some(Bar {
-                        lo: 0.0,
-                        hi,
-                        palette: Palette::Sequential,
-                    }),
-                }
+                deviation_row(name, before, &grid, &mut meshes, &camera)?
             }
         };
         rows.push(row);
@@ -346,6 +265,115 @@ pub(crate) fn figure(
     Ok(Figure {
         rows,
         panel: [v.width, v.height],
+    })
+}
+
+/// A row of a curvature map (`kind` one of the four curvatures): every panel on one
+/// diverging colour scale, symmetric about zero.
+fn curvature_row(
+    kind: SurfaceKind,
+    title: String,
+    meshes: &mut [SurfaceMesh],
+    camera: &Camera,
+) -> Row {
+    let field = match kind {
+        SurfaceKind::Gaussian => Field::Gaussian,
+        SurfaceKind::Mean => Field::Mean,
+        SurfaceKind::Kappa1 => Field::Kappa1,
+        _ => Field::Kappa2,
+    };
+    let mut m = 0.0f64;
+    for mesh in meshes.iter_mut() {
+        mesh.set_field(field);
+        if let Some((lo, hi)) = mesh.value_range() {
+            m = m.max(lo.abs()).max(hi.abs());
+        }
+    }
+    if m == 0.0 {
+        // A plane: any symmetric range draws it white.
+        m = 1.0;
+    }
+    let shading = Shading::Map {
+        lo: -m,
+        hi: m,
+        palette: Palette::Diverging,
+    };
+    Row {
+        title,
+        panels: meshes.iter().map(|x| render(x, camera, &shading)).collect(),
+        bar: Some(Bar {
+            lo: -m,
+            hi: m,
+            palette: Palette::Diverging,
+        }),
+    }
+}
+
+/// A row of isophotes or zebra stripes (`kind`).
+fn stripes_row(
+    kind: SurfaceKind,
+    title: String,
+    meshes: &[SurfaceMesh],
+    camera: &Camera,
+    v: &Views,
+) -> Row {
+    // Bands over the range seen on both panels, so a gently curved hood shows
+    // as many as a ball and before and after share them.
+    let shading = if kind == SurfaceKind::Isophotes {
+        let light = v.light.unwrap_or(v.view);
+        let (lo, hi) = isophote_range(&meshes.iter().collect::<Vec<_>>(), camera, light);
+        Shading::Isophotes {
+            light,
+            lo,
+            hi,
+            bands: usize::from(v.stripes),
+        }
+    } else {
+        let (lo, hi) = zebra_range(&meshes.iter().collect::<Vec<_>>(), camera);
+        Shading::Zebra {
+            lo,
+            hi,
+            stripes: usize::from(v.stripes),
+        }
+    };
+    Row {
+        title,
+        panels: meshes.iter().map(|x| render(x, camera, &shading)).collect(),
+        bar: None,
+    }
+}
+
+/// The row of the deviation map: the distance from `before` drawn on the faired surface
+/// (the second mesh, sampled at `grid`).
+///
+/// # Errors
+/// `deviation` without a faired surface (exit 2); the library's refusal to compare.
+fn deviation_row(
+    name: &str,
+    before: &BSplineSurface,
+    grid: &SampleGrid,
+    meshes: &mut [SurfaceMesh],
+    camera: &Camera,
+) -> Result<Row, Failure> {
+    let Some(mesh) = meshes.get_mut(1) else {
+        return Err(Failure::usage(anyhow!("--kind deviation needs --faired")));
+    };
+    mesh.set_deviation(before, grid)
+        .map_err(|e| Failure::from_batten("", e))?;
+    let hi = mesh.value_range().map_or(0.0, |r| r.1);
+    let shading = Shading::Map {
+        lo: 0.0,
+        hi,
+        palette: Palette::Sequential,
+    };
+    Ok(Row {
+        title: format!("{name}: distance to the faired surface, on the faired one"),
+        panels: vec![render(mesh, camera, &shading)],
+        bar: Some(Bar {
+            lo: 0.0,
+            hi,
+            palette: Palette::Sequential,
+        }),
     })
 }
 

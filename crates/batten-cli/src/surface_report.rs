@@ -190,6 +190,8 @@ fn image(
     ))
 }
 
+/// The page: the input's metrics and views, the table of the methods' results, and a
+/// section per method.
 fn page(
     name: &str,
     s: &BSplineSurface,
@@ -224,6 +226,21 @@ fn page(
         a.samples[1],
         env!("CARGO_PKG_VERSION")
     );
+    input_section(&mut h, name, s, a, views)?;
+    comparison_table(&mut h, runs);
+    method_sections(&mut h, name, s, runs, views)?;
+    h.push_str("</body>\n</html>\n");
+    Ok(h)
+}
+
+/// The input's section: its metrics and the views of [`INPUT_VIEWS`].
+fn input_section(
+    h: &mut String,
+    name: &str,
+    s: &BSplineSurface,
+    a: &SurfaceAnalysis,
+    views: &Views,
+) -> Result<(), Failure> {
     h.push_str("<h2>Input</h2>\n<table class=\"metrics\">\n");
     for (k, v) in [
         ("κ1", range(a.kappa1)),
@@ -244,7 +261,11 @@ fn page(
         views,
         "the input's Gaussian and mean curvature and isophotes",
     )?);
+    Ok(())
+}
 
+/// The table of the methods' results, a row each (or the reason it failed).
+fn comparison_table(h: &mut String, runs: &[Run]) {
     h.push_str(
         "<h2>Comparison</h2>\n<table class=\"compare\">\n<tr><th>method</th>\
                 <th>Π̂ after</th><th>κ1 after</th><th>κ2 after</th><th>moves</th>\
@@ -280,6 +301,16 @@ fn page(
         }
     }
     h.push_str("</table>\n");
+}
+
+/// A section per method: what it did, and the views of [`METHOD_VIEWS`] before and after.
+fn method_sections(
+    h: &mut String,
+    name: &str,
+    s: &BSplineSurface,
+    runs: &[Run],
+    views: &Views,
+) -> Result<(), Failure> {
     for (m, run) in runs {
         let _ = writeln!(h, "<h2>{}</h2>", m.name());
         match run {
@@ -308,6 +339,5 @@ fn page(
             }
         }
     }
-    h.push_str("</body>\n</html>\n");
-    Ok(h)
+    Ok(())
 }
