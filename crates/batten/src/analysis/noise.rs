@@ -10,7 +10,7 @@
 //! `σ̂ = 1.4826 · median |n_i · Δᵏp_i| / √C(2k, k)` (1.4826 makes the MAD a consistent
 //! estimator of σ for Gaussian noise).
 //!
-//! The order is 5 (`√C(10, 5) = √252`), 3 below [`FIFTH_ORDER_POINTS`] points. Each order
+//! The order is 5 (`√C(10, 5) = √252`), 3 below `FIFTH_ORDER_POINTS` points. Each order
 //! divides the curve's own part by about `h / L` (`L` the curve's length scale) and leaves the
 //! noise's, so a coarse clean curve is not taken for noise: exact samples of the benchmark's
 //! ten curve families at 30 points give σ̂ a median of 3.6e-4 of the diagonal with third
@@ -48,14 +48,14 @@ const FIFTH: (&[f64], f64) = (&[-1.0, 5.0, -10.0, 10.0, -5.0, 1.0], 15.874_507_8
 const NORMAL_CHORD_NOISE_SPANS: f64 = 20.0;
 
 /// The noise estimate σ̂ of the points `pts` (per coordinate, in data units), from the
-/// differences of order 5 (3 below [`FIFTH_ORDER_POINTS`] points) along the local normal.
+/// differences of order 5 (3 below `FIFTH_ORDER_POINTS` points) along the local normal.
 /// Closed curves wrap around. Returns 0 for fewer than four points or where every normal
 /// component vanishes (points on a line, exact samples of a parabola).
 ///
 /// The normal at a difference over `p_i … p_{i+k}` is that of the chord `p_{i+k+m} −
 /// p_{i−m}` (indices clamped at the ends of an open curve), with `m = 0` unless the noise is
 /// comparable to the point spacing: `m` is chosen so the chord spans about
-/// [`NORMAL_CHORD_NOISE_SPANS`] times a rough noise scale (the same MAD taken over the whole
+/// `NORMAL_CHORD_NOISE_SPANS` times a rough noise scale (the same MAD taken over the whole
 /// difference vectors, an overestimate) — at most an eighth of the points.
 pub fn noise_sigma(pts: &[Point], closed: bool) -> f64 {
     let xy: Vec<[f64; 2]> = pts.iter().map(|p| [p.x, p.y]).collect();
@@ -78,7 +78,7 @@ const PLANAR_REL: f64 = 1e-9;
 /// coordinate its length has the median `σ·√C(2k, k)·√(2 ln 2)`
 /// ([`MEDIAN_LENGTH_2D_TO_SIGMA`]).
 ///
-/// Points that lie in one plane (to [`PLANAR_REL`] of their size: a planar curve embedded in
+/// Points that lie in one plane (to `PLANAR_REL` of their size: a planar curve embedded in
 /// space, noise included) have a 1-D off-tangent part, the planar normal component, and get
 /// [`noise_sigma`]'s factor: their σ̂ is the planar one (bit for bit at `z ≡ 0`, to rounding in
 /// any other plane).
@@ -92,9 +92,9 @@ pub fn noise_sigma_space(pts: &[[f64; 3]], closed: bool) -> f64 {
     to_sigma * median / gain
 }
 
-/// Whether the points lie in one plane (to [`PLANAR_REL`] of their size; noise included, so
+/// Whether the points lie in one plane (to `PLANAR_REL` of their size; noise included, so
 /// the noise lies in that plane too): every deviation from the centroid (in units of the
-/// largest coordinate deviation, so nothing over- or underflows) is within [`PLANAR_REL`] off
+/// largest coordinate deviation, so nothing over- or underflows) is within `PLANAR_REL` off
 /// the plane of Newell's normal, the sum of the cross products of consecutive deviations,
 /// each turned to agree with the sum so far (so a figure eight does not cancel it). Points
 /// on a line are planar.

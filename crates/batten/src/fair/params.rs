@@ -56,7 +56,7 @@ impl<K: Kind + 'static> Param<K> {
 }
 
 /// The description of one method parameter, for validation and `batten methods`: the table
-/// entry made from its declaration ([`Param::spec`]).
+/// entry made from its declaration (`Param::spec`).
 #[derive(Clone, Copy, Debug)]
 pub struct ParamSpec {
     /// The key used in `--set key=value`.

@@ -108,7 +108,7 @@ impl<'a> SpaceSampled<'a> {
 
 /// The automatic comb scale for drawing `input` and `others` with one scale (see
 /// [`super::auto_comb_scale`]): the largest tooth drawn of any of them is
-/// [`DEFAULT_COMB_FRACTION`] of the diagonal of `input`'s bounding box; 0 when all are
+/// `DEFAULT_COMB_FRACTION` of the diagonal of `input`'s bounding box; 0 when all are
 /// straight.
 ///
 /// # Errors
@@ -126,15 +126,15 @@ fn space_scale_for(input: &SpaceSeq, max_curvature: f64) -> f64 {
 }
 
 /// Draw the space curve `input`, and `faired` over it when given, as an SVG document of
-/// five stacked panels (see the [module docs](self)): the three views, κ(s) and τ(s). Each
+/// five stacked panels (see the module docs): the three views, κ(s) and τ(s). Each
 /// panel is [`PlotOptions::height`] high; [`PlotOptions::kind`] and
 /// [`PlotOptions::rho_max`] do not apply, [`PlotOptions::comb_scale`] fixes the comb scale
 /// and [`PlotOptions::title`] adds a heading.
 ///
 /// # Errors
-/// - [`Error::InvalidParameter`] for bad options ([`PlotOptions::validate`]) and a `faired`
+/// - [`crate::Error::InvalidParameter`] for bad options ([`PlotOptions::validate`]) and a `faired`
 ///   curve that is closed where the input is open or the other way round;
-/// - [`Error::LengthMismatch`] when `faired` has another number of points;
+/// - [`crate::Error::LengthMismatch`] when `faired` has another number of points;
 /// - the analysis curve's errors.
 pub fn render_space(
     input: &SpaceSeq,

@@ -18,9 +18,8 @@ pub(super) const DEFAULT_WINDOW: usize = 50;
 /// Stop when Ê fell by less than this fraction of its value M iterations earlier.
 pub(super) const WINDOW_MIN_REL_IMPROVEMENT: f64 = 1e-3;
 
-/// Parameters of [`fair_curve`]. Start from [`SalviParams::DEFAULT`].
-///
-/// [`fair_curve`]: super::fair_curve
+/// Parameters of [`salvi_fair_curve`](crate::fair::salvi_fair_curve). Start from
+/// [`SalviParams::DEFAULT`].
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct SalviParams {
@@ -37,27 +36,25 @@ pub struct SalviParams {
     /// Default value: `false`.
     pub pin_ends: bool,
     /// δ, the largest distance of a control point from its original position; `None`:
-    /// [`local::DEFAULT_TOLERANCE_REL`] × the bounding-box diagonal of the control points.
+    /// `local::DEFAULT_TOLERANCE_REL` × the bounding-box diagonal of the control points.
     ///
     /// Default value: `None`.
-    ///
-    /// [`local::DEFAULT_TOLERANCE_REL`]: crate::fair::local::DEFAULT_TOLERANCE_REL
     pub tolerance: Option<f64>,
     /// Length R of the recently-moved list.
     ///
-    /// Default value: [`DEFAULT_TABU_LENGTH`] (4).
+    /// Default value: `DEFAULT_TABU_LENGTH` (4).
     pub tabu_length: usize,
     /// Iteration limit.
     ///
-    /// Default value: [`DEFAULT_MAX_ITERATIONS`] (1000).
+    /// Default value: `DEFAULT_MAX_ITERATIONS` (1000).
     pub max_iterations: usize,
     /// Window M of the stopping rule; 0 disables it (run `max_iterations`).
     ///
-    /// Default value: [`DEFAULT_WINDOW`] (50).
+    /// Default value: `DEFAULT_WINDOW` (50).
     pub window: usize,
     /// Relative improvement over the window below which the run stops.
     ///
-    /// Default value: [`WINDOW_MIN_REL_IMPROVEMENT`].
+    /// Default value: `WINDOW_MIN_REL_IMPROVEMENT` (1e-3).
     pub min_rel_improvement: f64,
     /// Let the first and last control points move.
     ///
@@ -69,13 +66,11 @@ pub struct SalviParams {
     /// Default value: 1.
     pub held_ends: usize,
     /// Skip a control point whose last search made no progress (relative local improvement
-    /// below [`STALL_REL_IMPROVEMENT`]) until a control point whose support overlaps its own
+    /// below `STALL_REL_IMPROVEMENT`) until a control point whose support overlaps its own
     /// makes progress; stop when every movable point is skipped. `false` follows spec §3 step 5
     /// literally (see the module documentation).
     ///
     /// Default value: `true`.
-    ///
-    /// [`STALL_REL_IMPROVEMENT`]: super::STALL_REL_IMPROVEMENT
     pub skip_stalled: bool,
 }
 
