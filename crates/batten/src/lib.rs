@@ -51,6 +51,8 @@ pub mod numeric;
 pub mod plot;
 pub mod spline;
 pub mod surface;
+#[cfg(test)]
+mod test_rng;
 
 pub use analysis::FairnessMetrics;
 pub use curve::{Curve, CurveDeriv, Derivatives, Piecewise};

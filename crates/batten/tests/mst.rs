@@ -5,34 +5,16 @@
 
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
 use batten::curve::{Curve, CurveDeriv};
 use batten::fair::{self, FairMethod, Mst, Smoothing, SmoothingSpline};
 use batten::spline::{Parametrization, parameters};
 use batten::{Error, FairOptions, Point, PointSeq, Rigid, Vec2};
+use common::Rng;
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
 use serde_json::Value;
-
-/// A small deterministic generator (xorshift64*) with Gaussian samples, so that the tests do
-/// not depend on a random-number crate.
-struct Rng(u64);
-
-impl Rng {
-    fn new(seed: u64) -> Rng {
-        Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
-    }
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        let v = self.0.wrapping_mul(0x2545_F491_4F6C_DD1D);
-        ((v >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-    fn normal(&mut self) -> f64 {
-        let (u, v) = (self.uniform(), self.uniform());
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    }
-}
 
 fn scale_of(points: &[Point]) -> f64 {
     batten::BBox::from_points(points).unwrap().diagonal()
@@ -57,7 +39,7 @@ fn noisy_open(seed: u64, n: usize, sigma: f64) -> (Vec<Point>, Vec<Point>) {
         .collect();
     let noisy = truth
         .iter()
-        .map(|p| Point::new(p.x + sigma * rng.normal(), p.y + sigma * rng.normal()))
+        .map(|p| Point::new(p.x + sigma * rng.gaussian(), p.y + sigma * rng.gaussian()))
         .collect();
     (truth, noisy)
 }
@@ -70,8 +52,8 @@ fn noisy_closed(seed: u64, n: usize, sigma: f64) -> Vec<Point> {
             let a = std::f64::consts::TAU * i as f64 / n as f64;
             let r = 1.0 + 0.2 * (3.0 * a).cos();
             Point::new(
-                2.0 * r * a.cos() + sigma * rng.normal(),
-                r * a.sin() + sigma * rng.normal(),
+                2.0 * r * a.cos() + sigma * rng.gaussian(),
+                r * a.sin() + sigma * rng.gaussian(),
             )
         })
         .collect()

@@ -11,52 +11,9 @@ use std::f64::consts::TAU;
 
 use batten::Point;
 
-/// A seeded xorshift (shifts 13, 7, 17) with uniform and Gaussian samples.
-#[derive(Clone, Debug)]
-pub struct Rng(u64);
-
-impl Rng {
-    /// The generator for `seed`: any seed, 0 included, gives a nonzero state.
-    pub fn new(seed: u64) -> Rng {
-        Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
-    }
-
-    /// Uniform in [0, 1), on a grid of 2⁻⁵³.
-    pub fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform in [−0.5, 0.5).
-    pub fn centered(&mut self) -> f64 {
-        self.uniform() - 0.5
-    }
-
-    /// A standard normal sample: Box–Muller on two uniform samples.
-    pub fn gaussian(&mut self) -> f64 {
-        let (a, b) = (self.uniform(), self.uniform());
-        (-2.0 * a.max(1e-300).ln()).sqrt() * (TAU * b).cos()
-    }
-
-    /// One sample of `noise`.
-    pub fn sample(&mut self, noise: Noise) -> f64 {
-        match noise {
-            Noise::Uniform(width) => width * self.centered(),
-            Noise::Gaussian(sigma) => sigma * self.gaussian(),
-        }
-    }
-}
-
-/// Noise added to each coordinate.
-#[derive(Clone, Copy, Debug)]
-pub enum Noise {
-    /// Uniform of this width, centred on zero: `width · [−0.5, 0.5)`.
-    Uniform(f64),
-    /// Gaussian with this standard deviation.
-    Gaussian(f64),
-}
+#[path = "../../src/test_rng.rs"]
+mod test_rng;
+pub(crate) use test_rng::{Noise, Rng};
 
 /// `points` with `noise` from `seed` added to each coordinate.
 pub fn jitter(points: &[Point], noise: Noise, seed: u64) -> Vec<Point> {

@@ -19,29 +19,9 @@ use crate::{Curve, Error, FairOptions, Point, PointSeq};
 use proptest::prelude::*;
 use serde_json::Value;
 
+use crate::test_rng::Rng;
+
 const VECTORS: &str = include_str!("../../../tests/data/test-vectors.json");
-
-/// The seeded xorshift of `tests/common` (shifts 13, 7, 17), for the same noise.
-struct Rng(u64);
-
-impl Rng {
-    fn new(seed: u64) -> Rng {
-        Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
-    }
-
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// A standard normal sample: Box–Muller on two uniform samples.
-    fn gaussian(&mut self) -> f64 {
-        let (a, b) = (self.uniform(), self.uniform());
-        (-2.0 * a.max(1e-300).ln()).sqrt() * (std::f64::consts::TAU * b).cos()
-    }
-}
 
 fn vector(id: &str) -> Value {
     let all: Value = serde_json::from_str(VECTORS).expect("test-vectors.json parses");
