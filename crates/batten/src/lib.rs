@@ -53,6 +53,8 @@ pub mod spline;
 pub mod surface;
 #[cfg(test)]
 mod test_rng;
+#[cfg(test)]
+mod test_vectors;
 
 pub use analysis::FairnessMetrics;
 pub use curve::{Curve, CurveDeriv, Derivatives, Piecewise};

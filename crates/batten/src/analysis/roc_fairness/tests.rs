@@ -17,43 +17,10 @@ use crate::fair::{self, FairOptions};
 use crate::geom::{Point, PointSeq, Vec2};
 use crate::spline::BSplineCurve;
 use crate::spline::quintic::{self, Ends, QuinticForm};
+use crate::test_vectors::{self, close, num, nums, points};
 
 fn vector(id: &str) -> Value {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/test-vectors.json");
-    let text = std::fs::read_to_string(path).expect("test vectors");
-    let all: Value = serde_json::from_str(&text).expect("valid JSON");
-    all["kuragano"]
-        .as_array()
-        .expect("kuragano vectors")
-        .iter()
-        .find(|v| v["id"] == id)
-        .unwrap_or_else(|| panic!("vector {id}"))
-        .clone()
-}
-
-fn num(v: &Value) -> f64 {
-    v.as_f64().expect("number")
-}
-
-fn nums(v: &Value) -> Vec<f64> {
-    v.as_array().expect("array").iter().map(num).collect()
-}
-
-fn points(v: &Value) -> Vec<Point> {
-    v.as_array()
-        .expect("point list")
-        .iter()
-        .map(|p| Point::new(num(&p[0]), num(&p[1])))
-        .collect()
-}
-
-/// The spec §7 check `|got − exp| ≤ abs + rel·|exp|`.
-fn close(got: f64, exp: f64, tol: &Value, what: &str) {
-    let (abs, rel) = (num(&tol["abs"]), num(&tol["rel"]));
-    assert!(
-        (got - exp).abs() <= abs + rel * exp.abs(),
-        "{what}: got {got:e}, expected {exp:e}"
-    );
+    test_vectors::vector("kuragano", id)
 }
 
 /// The curve of `ky.interpolate.gradients_and_rho_fit` and its inputs.

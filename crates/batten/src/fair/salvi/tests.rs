@@ -20,50 +20,14 @@ use proptest::prelude::*;
 use serde_json::Value;
 
 use crate::test_rng::Rng;
-
-const VECTORS: &str = include_str!("../../../tests/data/test-vectors.json");
+use crate::test_vectors::{self, nums, points};
 
 fn vector(id: &str) -> Value {
-    let all: Value = serde_json::from_str(VECTORS).expect("test-vectors.json parses");
-    all["salvi_varady"]
-        .as_array()
-        .expect("salvi_varady is a list")
-        .iter()
-        .find(|v| v["id"] == id)
-        .unwrap_or_else(|| panic!("vector {id} not found"))
-        .clone()
+    test_vectors::vector("salvi_varady", id)
 }
 
-fn floats(v: &Value) -> Vec<f64> {
-    v.as_array()
-        .expect("array")
-        .iter()
-        .map(|x| x.as_f64().expect("number"))
-        .collect()
-}
-
-fn points(v: &Value) -> Vec<Point> {
-    v.as_array()
-        .expect("array")
-        .iter()
-        .map(|p| {
-            let c = floats(p);
-            Point::new(c[0], c[1])
-        })
-        .collect()
-}
-
-/// `|got − exp| ≤ abs + rel·|exp|` element-wise (spec §7).
 fn assert_close(got: &[f64], exp: &[f64], tol: &Value, what: &str) {
-    let abs = tol["abs"].as_f64().expect("abs");
-    let rel = tol["rel"].as_f64().expect("rel");
-    assert_eq!(got.len(), exp.len(), "{what}: length");
-    for (i, (g, e)) in got.iter().zip(exp).enumerate() {
-        assert!(
-            (g - e).abs() <= abs + rel * e.abs(),
-            "{what}[{i}]: got {g}, expected {e}"
-        );
-    }
+    test_vectors::all_close(got, exp, tol, what);
 }
 
 /// A clamped uniform cubic with control points on `f`.
@@ -151,15 +115,15 @@ fn vector_curvature_samples() {
     let inp = &v["inputs"];
     let curve = BSplineCurve::try_new(
         inp["degree"].as_u64().expect("degree") as usize,
-        KnotVector::try_new(floats(&inp["knots"])).expect("knots"),
+        KnotVector::try_new(nums(&inp["knots"])).expect("knots"),
         points(&inp["control_points"]),
         None,
     )
     .expect("curve");
-    let kappa = sample_curvature(&curve, &floats(&inp["t"])).expect("curvature");
+    let kappa = sample_curvature(&curve, &nums(&inp["t"])).expect("curvature");
     assert_close(
         &kappa,
-        &floats(&v["expected"]["kappa"]),
+        &nums(&v["expected"]["kappa"]),
         &v["tolerance"],
         "kappa",
     );
@@ -168,13 +132,13 @@ fn vector_curvature_samples() {
 #[test]
 fn vector_target_smoothing() {
     let v = vector("sv.target_smoothing");
-    let kappa = floats(&v["inputs"]["kappa"]);
+    let kappa = nums(&v["inputs"]["kappa"]);
     let exp = &v["expected"];
     let tol = &v["tolerance"];
     let g1 = moving_average(&kappa, 1, 1);
-    assert_close(&g1, &floats(&exp["h1_passes1"]), tol, "h1_passes1");
+    assert_close(&g1, &nums(&exp["h1_passes1"]), tol, "h1_passes1");
     let g2 = moving_average(&kappa, 2, 3);
-    assert_close(&g2, &floats(&exp["h2_passes3"]), tol, "h2_passes3");
+    assert_close(&g2, &nums(&exp["h2_passes3"]), tol, "h2_passes3");
     let m = target_measure(&kappa, &g1);
     // The stored measure has 12 significant digits.
     assert!((m - exp["measure_h1_passes1"].as_f64().expect("measure")).abs() < 1e-10);
@@ -193,13 +157,13 @@ fn vector_target_smoothing() {
         false,
     )
     .expect("target");
-    assert_close(&g, &floats(&exp["h2_passes3"]), tol, "target_curvature");
+    assert_close(&g, &nums(&exp["h2_passes3"]), tol, "target_curvature");
 }
 
 #[test]
 fn vector_clamp_eq11() {
     let v = vector("sv.clamp_eq11");
-    let orig = floats(&v["inputs"]["d_orig"]);
+    let orig = nums(&v["inputs"]["d_orig"]);
     let orig = [orig[0], orig[1]];
     let results = v["expected"]["results"].as_array().expect("results");
     for (case, exp) in v["inputs"]["cases"]
@@ -208,27 +172,27 @@ fn vector_clamp_eq11() {
         .iter()
         .zip(results)
     {
-        let new = floats(&case["d_new"]);
+        let new = nums(&case["d_new"]);
         let (got, _) = clamp_to_original(
             &orig,
             &[new[0], new[1]],
             case["delta"].as_f64().expect("delta"),
         );
-        assert_close(&got, &floats(exp), &v["tolerance"], "clamp");
+        assert_close(&got, &nums(exp), &v["tolerance"], "clamp");
     }
 }
 
 #[test]
 fn vector_support_counts() {
     let v = vector("sv.support_counts");
-    let knots = KnotVector::try_new(floats(&v["inputs"]["knots"])).expect("knots");
+    let knots = KnotVector::try_new(nums(&v["inputs"]["knots"])).expect("knots");
     let n = v["inputs"]["N"].as_u64().expect("N") as usize;
     let t = uniform_samples((0.0, 1.0), n);
     let ranges = support_ranges(&knots, 3, knots.len() - 4, &t).expect("ranges");
     let counts: Vec<f64> = ranges.iter().map(|r| r.len() as f64).collect();
     assert_close(
         &counts,
-        &floats(&v["expected"]["counts_j_0_to_7"]),
+        &nums(&v["expected"]["counts_j_0_to_7"]),
         &v["tolerance"],
         "counts",
     );
@@ -247,18 +211,18 @@ fn vector_principal_curvatures_paraboloid() {
                 .expect("row")
                 .iter()
                 .map(|p| {
-                    let c = floats(p);
+                    let c = nums(p);
                     [c[0], c[1], c[2]]
                 })
                 .collect()
         })
         .collect();
-    let uv = floats(&inp["uv"]);
+    let uv = nums(&inp["uv"]);
     // The tensor-product basis, from two B-spline curves whose control points are unused.
     let basis = |knots: &Value, n: usize, t: f64| {
         let c = BSplineCurve::try_new(
             3,
-            KnotVector::try_new(floats(knots)).expect("knots"),
+            KnotVector::try_new(nums(knots)).expect("knots"),
             vec![Point::ORIGIN; n],
             None,
         )
@@ -301,7 +265,7 @@ fn vector_principal_curvatures_paraboloid() {
         tol,
         "kappa",
     );
-    assert_close(&pc.normal, &floats(&exp["normal"]), tol, "normal");
+    assert_close(&pc.normal, &nums(&exp["normal"]), tol, "normal");
 }
 
 // ---------------------------------------------------------------------------------------------
