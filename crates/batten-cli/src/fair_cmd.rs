@@ -24,7 +24,7 @@ const DIGITS: usize = 4;
 /// # Errors
 /// Usage errors (exit 2); a method failure or a failed write (exit 1).
 pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
-    let (method, options) = method_options(args)?;
+    let (method, options) = input::method_options(&args.how, &args.bounds, args.closed)?;
     let in_format = formats::format_of(&args.input, args.pick.format)?;
     let out_format = formats::format_of(&args.output, args.pick.format)?;
     let input_name = formats::display_name(&args.input);
@@ -105,29 +105,6 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
     let figures = figures(&faired.report);
     output::note(&summary_line(&figures, data.map(|d| d.lines.as_slice())));
     Ok(verdict(&figures, args.report.is_some()))
-}
-
-/// The method and the options of `batten fair`, checked against each other.
-///
-/// # Errors
-/// [`Failure::usage`]: an unknown method, a malformed or unknown `--set`, an option the
-/// method does not take.
-fn method_options(args: &FairArgs) -> Result<(&'static dyn FairMethod, FairOptions), Failure> {
-    let name = args
-        .how
-        .method
-        .as_deref()
-        .unwrap_or_else(|| fair::default_method());
-    let method = input::method(name)?;
-    let params = input::parse_sets(&args.how.set)?;
-    let options = input::options(
-        args.bounds.tolerance,
-        args.bounds.fix_ends.unwrap_or_default(),
-        args.how.max_iterations,
-        params,
-    );
-    input::check(method, args.closed, &options)?;
-    Ok((method, options))
 }
 
 /// The format of `--curve-out`, once it is known to take a B-spline, to be writable, and to

@@ -189,6 +189,33 @@ pub fn options(
     o
 }
 
+/// The method `how` names (or the default) and the options of `how` and `bounds`, checked
+/// against each other for a curve that is `closed` or not (`fair` and `batch`).
+///
+/// # Errors
+/// [`Failure::usage`]: an unknown method, a malformed or unknown `--set`, an option the
+/// method does not take.
+pub fn method_options(
+    how: &MethodArgs,
+    bounds: &BoundArgs,
+    closed: bool,
+) -> Result<(&'static dyn FairMethod, FairOptions), Failure> {
+    let name = how
+        .method
+        .as_deref()
+        .unwrap_or_else(|| fair::default_method());
+    let method = method(name)?;
+    let params = parse_sets(&how.set)?;
+    let options = options(
+        bounds.tolerance,
+        bounds.fix_ends.unwrap_or_default(),
+        how.max_iterations,
+        params,
+    );
+    check(method, closed, &options)?;
+    Ok((method, options))
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used)]
 mod tests {

@@ -35,7 +35,7 @@ use std::sync::{Arc, Mutex};
 
 use anyhow::anyhow;
 use batten::FairOptions;
-use batten::fair::{self, FairMethod};
+use batten::fair::FairMethod;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
@@ -91,7 +91,8 @@ type Finished = Arc<Mutex<Vec<Option<Vec<Row>>>>>;
 /// directory or to start the worker threads (exit 1). Problems with single files are not
 /// errors: they are rows of the summary and decide the exit code.
 pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
-    let (method, options) = method_options(args)?;
+    // Checked for an open curve; a file that says it is closed is checked again when read.
+    let (method, options) = input::method_options(&args.how, &args.bounds, false)?;
     let summary_format = match &args.summary {
         Some(path) => Some(summary::summary_format(path)?),
         None => None,
@@ -116,26 +117,6 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, Failure> {
         _ => Ok(()),
     };
     Ok(conclude(args, &rows, jobs.len(), summary_written))
-}
-
-/// The method and the options of the batch, checked against each other (for an open curve;
-/// a file that says it is closed is checked again when it is read).
-fn method_options(args: &BatchArgs) -> Result<(&'static dyn FairMethod, FairOptions), Failure> {
-    let name = args
-        .how
-        .method
-        .as_deref()
-        .unwrap_or_else(|| fair::default_method());
-    let method = input::method(name)?;
-    let params = input::parse_sets(&args.how.set)?;
-    let options = input::options(
-        args.bounds.tolerance,
-        args.bounds.fix_ends.unwrap_or_default(),
-        args.how.max_iterations,
-        params,
-    );
-    input::check(method, false, &options)?;
-    Ok((method, options))
 }
 
 /// The jobs of the inputs, once every check that needs no curve has passed and the output
