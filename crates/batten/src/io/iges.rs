@@ -246,6 +246,22 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Orig
     let gdata: Vec<u8> = g.iter().flat_map(|r| r.text[..DATA].to_vec()).collect();
     let (pd, rd) =
         delimiters(&gdata).map_err(|m| err(path, g[0].line, format!("global section: {m}")))?;
+    let dirs = directory(&d, path)?;
+    let e = choose(&dirs, pick, path)?;
+    let params = Params::of(e, &p, pd, rd, path)?;
+    let origin = Origin {
+        z: 0.0,
+        layer: Some(e.level.to_string()),
+        name: Some(e.de.to_string()),
+    };
+    if e.kind == 106 {
+        return copious_data(e, &params, origin);
+    }
+    b_spline(&params, origin)
+}
+
+/// The directory entries, two D records each.
+fn directory(d: &[Rec], path: &Path) -> Result<Vec<Dir>, IoError> {
     if d.len() % 2 == 1 {
         return Err(err(
             path,
@@ -281,25 +297,37 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Orig
             form: geti(b, 14)?,
         });
     }
-    let is_curve = |e: &Dir| {
-        let sub = e.status.get(2..4).unwrap_or("00");
-        let independent = matches!(sub, "00" | "02" | "" | "0");
-        independent && (e.kind == 126 || (e.kind == 106 && matches!(e.form, 1 | 2 | 11 | 12 | 63)))
-    };
-    let describe = |e: &Dir| {
-        format!(
-            "entity {} form {} at DE {} (level {})",
-            e.kind, e.form, e.de, e.level
-        )
-    };
+    Ok(dirs)
+}
+
+/// Whether a directory entry is a curve batten reads: an independent entity 126, or 106 of
+/// a form that holds a curve.
+fn is_curve(e: &Dir) -> bool {
+    let sub = e.status.get(2..4).unwrap_or("00");
+    let independent = matches!(sub, "00" | "02" | "" | "0");
+    independent && (e.kind == 126 || (e.kind == 106 && matches!(e.form, 1 | 2 | 11 | 12 | 63)))
+}
+
+/// A directory entry as messages name it.
+fn describe(e: &Dir) -> String {
+    format!(
+        "entity {} form {} at DE {} (level {})",
+        e.kind, e.form, e.de, e.level
+    )
+}
+
+/// Directory entries as messages list them.
+fn list(v: &[&Dir]) -> String {
+    if v.is_empty() {
+        "none".to_string()
+    } else {
+        v.iter().map(|e| describe(e)).collect::<Vec<_>>().join(", ")
+    }
+}
+
+/// The one curve entity `pick` leaves, or why there is none.
+fn choose<'d>(dirs: &'d [Dir], pick: &Pick, path: &Path) -> Result<&'d Dir, IoError> {
     let all: Vec<&Dir> = dirs.iter().filter(|e| is_curve(e)).collect();
-    let list = |v: &[&Dir]| {
-        if v.is_empty() {
-            "none".to_string()
-        } else {
-            v.iter().map(|e| describe(e)).collect::<Vec<_>>().join(", ")
-        }
-    };
     let mut chosen = all.clone();
     if let Some(de) = &pick.entity {
         let want = de
@@ -333,147 +361,181 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Orig
             ));
         }
     }
-    let e = match chosen.as_slice() {
-        [] => {
+    match chosen.as_slice() {
+        [] => Err(err(
+            path,
+            0,
+            "no entity 126 (B-spline curve) or 106 (copious data, forms 1, 2, 11, 12, 63)",
+        )),
+        [e] => Ok(*e),
+        many => Err(err(
+            path,
+            0,
+            format!(
+                "{} curve entities, pick one with --entity DE or --layer LEVEL: {}",
+                many.len(),
+                list(many)
+            ),
+        )),
+    }
+}
+
+/// The parameter data of the chosen entity, as tokens, with what names it in messages.
+struct Params<'a> {
+    toks: Vec<String>,
+    /// The entity as [`describe`] names it.
+    what: String,
+    /// The line of its first P record.
+    pline: usize,
+    path: &'a Path,
+}
+
+impl<'a> Params<'a> {
+    /// The entity's parameter data, checked to be where the directory says and to start
+    /// with the entity's type.
+    fn of(e: &Dir, p: &[Rec], pd: u8, rd: u8, path: &'a Path) -> Result<Params<'a>, IoError> {
+        let what = describe(e);
+        if e.matrix != 0 {
             return Err(err(
                 path,
-                0,
-                "no entity 126 (B-spline curve) or 106 (copious data, forms 1, 2, 11, 12, 63)",
-            ));
-        }
-        [e] => *e,
-        many => {
-            return Err(err(
-                path,
-                0,
+                e.line,
                 format!(
-                    "{} curve entities, pick one with --entity DE or --layer LEVEL: {}",
-                    many.len(),
-                    list(many)
+                    "{what} has a transformation matrix (DE {}), which batten does not apply",
+                    e.matrix
                 ),
             ));
         }
-    };
-    let what = describe(e);
-    if e.matrix != 0 {
-        return Err(err(
+        if e.param == 0 || e.param > p.len() || e.param - 1 + e.param_count.max(1) > p.len() {
+            return Err(err(
+                path,
+                e.line,
+                format!(
+                    "{what}: its parameter data pointer {} (with {} records) is outside the P section of {} records",
+                    e.param,
+                    e.param_count,
+                    p.len()
+                ),
+            ));
+        }
+        let recs = &p[e.param - 1..e.param - 1 + e.param_count.max(1)];
+        let data: Vec<u8> = recs
+            .iter()
+            .flat_map(|r| r.text[..P_DATA].to_vec())
+            .collect();
+        let pline = recs[0].line;
+        let toks = tokens(&data, pd, rd).map_err(|m| err(path, pline, format!("{what}: {m}")))?;
+        let params = Params {
+            toks,
+            what,
+            pline,
             path,
-            e.line,
-            format!(
-                "{what} has a transformation matrix (DE {}), which batten does not apply",
-                e.matrix
-            ),
-        ));
-    }
-    if e.param == 0 || e.param > p.len() || e.param - 1 + e.param_count.max(1) > p.len() {
-        return Err(err(
-            path,
-            e.line,
-            format!(
-                "{what}: its parameter data pointer {} (with {} records) is outside the P section of {} records",
-                e.param,
-                e.param_count,
-                p.len()
-            ),
-        ));
-    }
-    let recs = &p[e.param - 1..e.param - 1 + e.param_count.max(1)];
-    let data: Vec<u8> = recs
-        .iter()
-        .flat_map(|r| r.text[..P_DATA].to_vec())
-        .collect();
-    let pline = recs[0].line;
-    let toks = tokens(&data, pd, rd).map_err(|m| err(path, pline, format!("{what}: {m}")))?;
-    let fail = |m: String| err(path, pline, format!("{what}: {m}"));
-    let ti = |i: usize| -> Result<i64, IoError> {
-        let t = toks
-            .get(i)
-            .ok_or_else(|| fail(format!("{} parameters, more expected", toks.len())))?;
-        int(t).ok_or_else(|| fail(format!("parameter {i} '{t}' is not an integer")))
-    };
-    let tr = |i: usize| -> Result<f64, IoError> {
-        let t = toks
-            .get(i)
-            .ok_or_else(|| fail(format!("{} parameters, more expected", toks.len())))?;
-        real(t).ok_or_else(|| fail(format!("parameter {i} '{t}' is not a finite real")))
-    };
-    if ti(0)? != e.kind {
-        return Err(fail(format!(
-            "its parameter data starts with entity type '{}'",
-            toks.first().map_or("", String::as_str)
-        )));
-    }
-    let origin = Origin {
-        z: 0.0,
-        layer: Some(e.level.to_string()),
-        name: Some(e.de.to_string()),
-    };
-    // The constant z, or the first two values that differ.
-    let planar = |zs: &[f64]| -> Result<f64, (f64, f64)> {
-        match zs.iter().find(|&&z| z != zs[0]) {
-            Some(&z) => Err((zs[0], z)),
-            None => Ok(zs.first().copied().unwrap_or(0.0)),
-        }
-    };
-    if e.kind == 106 {
-        let ip = ti(1)?;
-        let n = usize::try_from(ti(2)?).map_err(|_| fail("negative point count".into()))?;
-        let (first, stride, zs) = match ip {
-            1 => (4, 2, None),
-            2 => (3, 3, Some(2)),
-            3 => (3, 6, Some(2)),
-            _ => {
-                return Err(fail(format!(
-                    "interpretation flag {ip}, expected 1, 2 or 3"
-                )));
-            }
         };
-        let mut points = Vec::with_capacity(n);
-        let mut z = Vec::with_capacity(n);
-        for i in 0..n {
-            let b = first + stride * i;
-            points.push(Point::new(tr(b)?, tr(b + 1)?));
-            z.push(match zs {
-                Some(o) => tr(b + o)?,
-                None => tr(3)?,
-            });
+        if params.int(0)? != e.kind {
+            return Err(params.fail(format!(
+                "its parameter data starts with entity type '{}'",
+                params.toks.first().map_or("", String::as_str)
+            )));
         }
-        let z = match planar(&z) {
-            Ok(z) => z,
-            Err(_) => {
-                let mut points: Vec<[f64; 3]> =
-                    points.iter().zip(&z).map(|(p, z)| [p.x, p.y, *z]).collect();
-                // A copious-data curve that returns to its start is closed.
-                let closed = points.len() > 1 && points.last() == points.first();
-                if closed {
-                    points.pop();
-                }
-                let lines = vec![pline; points.len()];
-                return Ok((
-                    Raw::Space {
-                        points,
-                        lines,
-                        closed,
-                    },
-                    origin,
-                ));
-            }
-        };
-        let closed = e.form == 63;
-        if closed && points.len() > 1 && points.last() == points.first() {
-            points.pop();
-        }
-        let lines = vec![pline; points.len()];
-        return Ok((
-            Raw::Points {
-                points,
-                lines,
-                closed,
-            },
-            Origin { z, ..origin },
-        ));
+        Ok(params)
     }
-    // Entity 126.
+
+    /// An error about the entity's parameter data.
+    fn fail(&self, m: String) -> IoError {
+        err(self.path, self.pline, format!("{}: {m}", self.what))
+    }
+
+    /// Parameter `i` as an integer.
+    fn int(&self, i: usize) -> Result<i64, IoError> {
+        let t = self
+            .toks
+            .get(i)
+            .ok_or_else(|| self.fail(format!("{} parameters, more expected", self.toks.len())))?;
+        int(t).ok_or_else(|| self.fail(format!("parameter {i} '{t}' is not an integer")))
+    }
+
+    /// Parameter `i` as a finite real.
+    fn real(&self, i: usize) -> Result<f64, IoError> {
+        let t = self
+            .toks
+            .get(i)
+            .ok_or_else(|| self.fail(format!("{} parameters, more expected", self.toks.len())))?;
+        real(t).ok_or_else(|| self.fail(format!("parameter {i} '{t}' is not a finite real")))
+    }
+}
+
+/// The constant z, or the first two values that differ.
+fn planar(zs: &[f64]) -> Result<f64, (f64, f64)> {
+    match zs.iter().find(|&&z| z != zs[0]) {
+        Some(&z) => Err((zs[0], z)),
+        None => Ok(zs.first().copied().unwrap_or(0.0)),
+    }
+}
+
+/// Entity 106: planar points, or space points when z varies.
+fn copious_data(e: &Dir, params: &Params<'_>, origin: Origin) -> Result<(Raw, Origin), IoError> {
+    let (ti, tr) = (|i| params.int(i), |i| params.real(i));
+    let pline = params.pline;
+    let ip = ti(1)?;
+    let n = usize::try_from(ti(2)?).map_err(|_| params.fail("negative point count".into()))?;
+    let (first, stride, zs) = match ip {
+        1 => (4, 2, None),
+        2 => (3, 3, Some(2)),
+        3 => (3, 6, Some(2)),
+        _ => {
+            return Err(params.fail(format!("interpretation flag {ip}, expected 1, 2 or 3")));
+        }
+    };
+    let mut points = Vec::with_capacity(n);
+    let mut z = Vec::with_capacity(n);
+    for i in 0..n {
+        let b = first + stride * i;
+        points.push(Point::new(tr(b)?, tr(b + 1)?));
+        z.push(match zs {
+            Some(o) => tr(b + o)?,
+            None => tr(3)?,
+        });
+    }
+    let z = match planar(&z) {
+        Ok(z) => z,
+        Err(_) => {
+            let mut points: Vec<[f64; 3]> =
+                points.iter().zip(&z).map(|(p, z)| [p.x, p.y, *z]).collect();
+            // A copious-data curve that returns to its start is closed.
+            let closed = points.len() > 1 && points.last() == points.first();
+            if closed {
+                points.pop();
+            }
+            let lines = vec![pline; points.len()];
+            return Ok((
+                Raw::Space {
+                    points,
+                    lines,
+                    closed,
+                },
+                origin,
+            ));
+        }
+    };
+    let closed = e.form == 63;
+    if closed && points.len() > 1 && points.last() == points.first() {
+        points.pop();
+    }
+    let lines = vec![pline; points.len()];
+    Ok((
+        Raw::Points {
+            points,
+            lines,
+            closed,
+        },
+        Origin { z, ..origin },
+    ))
+}
+
+/// Entity 126: a planar, untrimmed B-spline.
+fn b_spline(params: &Params<'_>, origin: Origin) -> Result<(Raw, Origin), IoError> {
+    let (ti, tr) = (|i| params.int(i), |i| params.real(i));
+    let fail = |m: String| params.fail(m);
+    let toks = &params.toks;
     let k = usize::try_from(ti(1)?).map_err(|_| fail("negative K".into()))?;
     let m = usize::try_from(ti(2)?).map_err(|_| fail("negative degree M".into()))?;
     let polynomial = ti(5)? == 1;
