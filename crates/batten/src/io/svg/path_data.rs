@@ -354,19 +354,7 @@ impl PathParser<'_> {
                     at,
                 });
             }
-            b'Z' => {
-                // `if let` on the last subpath: one exists (checked above).
-                if let Some(sp) = self.subpaths.last_mut() {
-                    if cur != sp.start {
-                        sp.segs.push(Seg::Line {
-                            p: [cur, sp.start],
-                            at,
-                        });
-                    }
-                    sp.closed = true;
-                    self.cur = sp.start;
-                }
-            }
+            b'Z' => self.close(at),
             b'A' => {
                 return err(
                     at,
@@ -384,6 +372,23 @@ impl PathParser<'_> {
             }
         }
         Ok(seg)
+    }
+
+    /// Z: close the current subpath (with a line back to its start when not there) and move
+    /// to its start.
+    fn close(&mut self, at: usize) {
+        let cur = self.cur;
+        // `if let` on the last subpath: one exists (checked above).
+        if let Some(sp) = self.subpaths.last_mut() {
+            if cur != sp.start {
+                sp.segs.push(Seg::Line {
+                    p: [cur, sp.start],
+                    at,
+                });
+            }
+            sp.closed = true;
+            self.cur = sp.start;
+        }
     }
 
     /// Add a drawn segment to the current subpath (or to a new one after Z) and move on to
