@@ -29,7 +29,7 @@ static PARAMS: &[ParamSpec] = &[P.spec()];
 /// The `mst` fairing method: the cubic smoothing spline of the points at chord-length
 /// parameters, with p given (`--set p=…`), chosen for `--tolerance`, or by GCV. See
 /// [`super::SmoothingSpline`] for the library API (the equations are in the source,
-/// `fair/smoothing.rs`).
+/// `fair/smoothing/`).
 ///
 /// Reports `p`, `alpha`, `selection` (`given`, `tolerance`, `gcv`), `roughness` and, for GCV,
 /// `gcv` and `degrees_of_freedom` in [`Outcome::parameters`]; iterations are the splines the

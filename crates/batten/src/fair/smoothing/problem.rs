@@ -289,7 +289,7 @@ impl<'a, const D: usize> Problem<'a, D> {
             by_coordinate(&mut u[1..n - 1], |c| mat.solve_in_place(c))?;
         } else {
             // The same entries and operations as the band code above, written out for
-            // half-bandwidth 2 (see `smoothing_system`).
+            // half-bandwidth 2 (see `system.rs`).
             let row = |terms: &KnotTerms<D>, uj: &mut [f64; D]| {
                 *uj = terms.qty;
                 terms.entries(a, b)
