@@ -105,11 +105,11 @@ pub(crate) enum Raw {
 }
 
 /// Parse any input format held in memory (a file's bytes, or standard input); `path` names
-/// it in messages. Points are validated as by [`parse_points`]; a B-spline is returned as
+/// it in messages. Points are validated as by [`parse_points`](super::parse_points); a B-spline is returned as
 /// it is.
 ///
 /// # Errors
-/// Everything [`parse_points`] reports, and [`IoError::Format`] for a malformed DXF, IGES or
+/// Everything [`parse_points`](super::parse_points) reports, and [`IoError::Format`] for a malformed DXF, IGES or
 /// SVG file, a 3-D curve (z not constant), or a choice the file leaves open.
 pub fn parse_input(
     bytes: &[u8],

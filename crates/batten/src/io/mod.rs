@@ -46,7 +46,7 @@
 //! # JSON format
 //!
 //! `{"points": [[x, y], ...], "closed": false, "tangents": [[dx, dy], ...]}`, `closed` and
-//! `tangents` optional; a B-spline as [`BSplineCurve`] serialises. Other keys are errors.
+//! `tangents` optional; a B-spline as [`BSplineCurve`](crate::spline::BSplineCurve) serialises. Other keys are errors.
 //!
 //! ```
 //! use batten::io::{read_points, write_points, ReadOptions};

@@ -28,7 +28,7 @@ pub fn read_points(path: &Path, options: &ReadOptions) -> Result<PointData, IoEr
 /// One error naming the line, for the first problem met: [`IoError::NotUtf8`],
 /// [`IoError::FieldCount`], [`IoError::NotANumber`], [`IoError::NonFinite`], [`IoError::Json`],
 /// [`IoError::CurveNotPoints`]; then, for the whole list, [`IoError::Empty`],
-/// [`IoError::TooLarge`] (beyond [`MAX_COORDINATE`]), [`IoError::TooFewPoints`],
+/// [`IoError::TooLarge`] (beyond [`MAX_COORDINATE`](super::MAX_COORDINATE)), [`IoError::TooFewPoints`],
 /// [`IoError::DuplicatePoint`], [`IoError::RepeatsFirst`], [`IoError::NearDuplicate`]
 /// (closer than [`crate::geom::NEAR_DUPLICATE_REL`] of the bounding box's larger side),
 /// [`IoError::TangentCount`].
@@ -238,7 +238,7 @@ pub(super) fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
 ///
 /// Text files get the header `x,y` and one row per point; `closed` and `tangents` are
 /// written to JSON only (a text file has no place for them). Numbers are written in the
-/// shortest form that reads back bit for bit ([`format_f64`] for text; serde_json's, which
+/// shortest form that reads back bit for bit ([`format_f64`](super::format_f64) for text; serde_json's, which
 /// is the same digits, for JSON).
 ///
 /// # Errors
@@ -254,7 +254,7 @@ pub fn write_points(
 }
 
 /// The text [`write_points`] would write to `path` (format by extension), to write it later
-/// with other files as one set ([`write_atomic_set`]).
+/// with other files as one set ([`write_atomic_set`](super::write_atomic_set)).
 ///
 /// # Errors
 /// [`IoError::UnknownFormat`], [`IoError::NonFiniteOutput`].

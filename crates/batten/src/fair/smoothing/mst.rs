@@ -35,7 +35,7 @@ static PARAMS: &[ParamSpec] = &[P.spec()];
 /// `gcv` and `degrees_of_freedom` in [`Outcome::parameters`]; iterations are the splines the
 /// search computed (bisection steps or GCV evaluations). [`Outcome::curve`] is left empty: the
 /// method's product is the points, and building the curve would triple its cost at 10⁶
-/// points; the library's [`SmoothingSpline::curve`] gives the spline itself
+/// points; the library's [`SmoothingSpline::curve`](super::SmoothingSpline::curve) gives the spline itself
 /// (`BSplineCurve::from_parametric_cubic` turns it into exact B-spline form).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Mst;
