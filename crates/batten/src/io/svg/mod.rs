@@ -156,7 +156,7 @@ fn choose<'a, 'input>(
             if !CURVE_ELEMENTS.contains(&n.tag_name().name()) {
                 return Err(format_err(
                     path,
-                    Location::Line(line_of(&doc, n)),
+                    Location::Line(line_of(doc, n)),
                     format!(
                         "element '{id}' is a <{}>, not a <path>, <polyline> or <polygon>",
                         n.tag_name().name()
@@ -175,7 +175,7 @@ fn choose<'a, 'input>(
             }
             [n] => *n,
             many => {
-                let list: Vec<String> = many.iter().map(|n| describe(&doc, *n)).collect();
+                let list: Vec<String> = many.iter().map(|n| describe(doc, *n)).collect();
                 return Err(format_err(
                     path,
                     Location::File,
