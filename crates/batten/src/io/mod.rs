@@ -33,7 +33,7 @@
 //! | SVG (`roxmltree`) | `<path>` (lines: points; Béziers: a cubic B-spline), `<polyline>`, `<polygon>` | a path of the C² cubic through the points | a path of Bézier segments |
 //!
 //! The curve must be planar (constant z; the z is kept in [`Origin`] and written back) and
-//! untransformed; each module's documentation (`io/dxf.rs`, `io/iges.rs`, `io/svg/`) says
+//! untransformed; each module's documentation (`io/dxf.rs`, `io/iges/`, `io/svg/`) says
 //! exactly what it takes and refuses. IGES, SVG, text and JSON read back bit for bit; DXF
 //! within the 12 decimal places the `dxf` crate writes.
 //!
