@@ -322,6 +322,78 @@ impl FairnessMetrics {
         if chunks.iter().any(|r| !r.finite) {
             return Err(Error::Singular("spline coefficients are not finite".into()));
         }
+        let Joined {
+            mut kappa_runs,
+            dk_runs,
+            jump_runs,
+            s_knots,
+            kappa_knots,
+            max_curvature,
+            length,
+            strain,
+            variation,
+            max_third_derivative_jump,
+        } = Joined::of(chunks, closed, m, dk_floor);
+        if !closed {
+            let c = spans.coeffs(m - 1);
+            let d = span_derivatives(&c, t[m] - t[m - 1]);
+            let mut end = SignRuns::default();
+            end.push(signed_curvature(&d), kappa_floor);
+            kappa_runs.push(end);
+        }
+        let inflections = count_runs(&kappa_runs, closed);
+        let curvature_extrema = count_runs(&dk_runs, closed);
+        let vibrations = count_runs(&jump_runs, closed);
+        drop((kappa_runs, dk_runs, jump_runs));
+
+        let gfi = if closed {
+            lfi_from_samples(&kappa_knots, &s_knots, Some(length))
+                .iter()
+                .sum()
+        } else {
+            // The open GFI is measured on another spline, through the same chord-length
+            // parameters: free the tangents first, so that the two are never held at once.
+            let AnalysisSpans { t, tangents, .. } = spans;
+            drop(tangents);
+            let (bs, _) = BSplineCurve::interpolate_at_parameters(seq.points(), 3, t)?;
+            fairness_indicators(&bs).gfi
+        };
+
+        Ok(FairnessMetrics {
+            points: seq.len(),
+            closed,
+            inflections,
+            vibrations,
+            curvature_extrema,
+            strain_energy: strain,
+            variation_energy: variation,
+            max_curvature,
+            gfi,
+            max_third_derivative_jump,
+            length,
+        })
+    }
+}
+
+/// The chunks' measurements joined in order: the runs of each quantity, part by part (with
+/// the knots between chunks, and P_0 of a closed curve), the knots' arc lengths and
+/// curvatures (closed curves), and the sums and maxima.
+struct Joined {
+    kappa_runs: Vec<SignRuns>,
+    dk_runs: Vec<SignRuns>,
+    jump_runs: Vec<SignRuns>,
+    s_knots: Vec<f64>,
+    kappa_knots: Vec<f64>,
+    max_curvature: f64,
+    length: f64,
+    strain: f64,
+    variation: f64,
+    max_third_derivative_jump: f64,
+}
+
+impl Joined {
+    /// Join `chunks` (in order) of a curve of `m` spans.
+    fn of(chunks: Vec<SpanSums>, closed: bool, m: usize, dk_floor: f64) -> Joined {
         // The runs of each quantity, part by part in order (counted, then freed, before the
         // GFI's spline is built).
         let mut kappa_runs = Vec::with_capacity(chunks.len() + 1);
@@ -364,44 +436,18 @@ impl FairnessMetrics {
             strain += r.strain;
             variation += r.variation;
         }
-        if !closed {
-            let c = spans.coeffs(m - 1);
-            let d = span_derivatives(&c, t[m] - t[m - 1]);
-            let mut end = SignRuns::default();
-            end.push(signed_curvature(&d), kappa_floor);
-            kappa_runs.push(end);
-        }
-        let inflections = count_runs(&kappa_runs, closed);
-        let curvature_extrema = count_runs(&dk_runs, closed);
-        let vibrations = count_runs(&jump_runs, closed);
-        drop((kappa_runs, dk_runs, jump_runs));
-
-        let gfi = if closed {
-            lfi_from_samples(&kappa_knots, &s_knots, Some(length))
-                .iter()
-                .sum()
-        } else {
-            // The open GFI is measured on another spline, through the same chord-length
-            // parameters: free the tangents first, so that the two are never held at once.
-            let AnalysisSpans { t, tangents, .. } = spans;
-            drop(tangents);
-            let (bs, _) = BSplineCurve::interpolate_at_parameters(seq.points(), 3, t)?;
-            fairness_indicators(&bs).gfi
-        };
-
-        Ok(FairnessMetrics {
-            points: seq.len(),
-            closed,
-            inflections,
-            vibrations,
-            curvature_extrema,
-            strain_energy: strain,
-            variation_energy: variation,
+        Joined {
+            kappa_runs,
+            dk_runs,
+            jump_runs,
+            s_knots,
+            kappa_knots,
             max_curvature,
-            gfi,
-            max_third_derivative_jump,
             length,
-        })
+            strain,
+            variation,
+            max_third_derivative_jump,
+        }
     }
 }
 

@@ -59,9 +59,6 @@ mod report;
 mod salvi;
 mod sapidis_farin;
 mod smoothing;
-mod smoothing_mst;
-mod smoothing_system;
-mod smoothing_trial;
 mod space;
 
 use std::time::Instant;

@@ -187,159 +187,159 @@ pub(crate) fn entity_curve(found: &Found<'_>, path: &Path) -> Result<(Raw, f64),
     let e = found.entity;
     let what = found.describe();
     let err = |m: String| format_err(path, format!("{what}: {m}"));
-    let extrusion = |v: &dxf::Vector| {
-        if v.x == 0.0 && v.y == 0.0 && v.z > 0.0 {
-            Ok(())
-        } else {
-            Err(err(format!(
-                "its plane has the normal ({}, {}, {}); batten takes curves in the world XY plane only",
-                v.x, v.y, v.z
-            )))
-        }
-    };
-    // The constant z, or the first two values that differ.
-    let planar = |zs: &mut dyn Iterator<Item = f64>| -> Result<f64, (f64, f64)> {
-        let mut z0 = None;
-        for z in zs {
-            match z0 {
-                None => z0 = Some(z),
-                Some(a) if a == z => {}
-                Some(a) => return Err((a, z)),
-            }
-        }
-        Ok(z0.unwrap_or(0.0))
-    };
-    // Space points, a closed entity's repeated first vertex left out.
-    let space = |mut points: Vec<Xyz>, closed: bool| {
-        if closed && points.len() > 1 && points.last() == points.first() {
-            points.pop();
-        }
-        let lines = vec![1; points.len()];
-        Ok((
-            Raw::Space {
-                points,
-                lines,
-                closed,
-            },
-            0.0,
-        ))
-    };
     match &e.specific {
-        EntityType::LwPolyline(lw) => {
-            extrusion(&lw.extrusion_direction)?;
-            if let Some(i) = lw.vertices.iter().position(|v| v.bulge != 0.0) {
-                return Err(err(format!(
-                    "vertex {} starts an arc segment (bulge); batten takes straight segments only",
-                    i + 1
-                )));
-            }
-            let mut points: Vec<Point> = lw.vertices.iter().map(|v| Point::new(v.x, v.y)).collect();
-            let closed = lw.is_closed();
-            if closed && points.len() > 1 && points.last() == points.first() {
-                points.pop();
-            }
-            let lines = vec![1; points.len()];
-            Ok((
-                Raw::Points {
-                    points,
-                    lines,
-                    closed,
-                },
-                e.common.elevation,
-            ))
-        }
-        EntityType::Polyline(pl) => {
-            extrusion(&pl.normal)?;
-            let verts: Vec<_> = pl
-                .vertices()
-                .filter(|v| v.flags & VERTEX_FRAME == 0)
-                .collect();
-            if let Some(i) = verts.iter().position(|v| v.bulge != 0.0) {
-                return Err(err(format!(
-                    "vertex {} starts an arc segment (bulge); batten takes straight segments only",
-                    i + 1
-                )));
-            }
-            let z = if pl.flags & POLYLINE_3D != 0 {
-                match planar(&mut verts.iter().map(|v| v.location.z)) {
-                    Ok(z) => z,
-                    Err(_) => {
-                        let pts = verts
-                            .iter()
-                            .map(|v| [v.location.x, v.location.y, v.location.z])
-                            .collect();
-                        return space(pts, pl.is_closed());
-                    }
-                }
-            } else {
-                pl.location.z
-            };
-            let mut points: Vec<Point> = verts
-                .iter()
-                .map(|v| Point::new(v.location.x, v.location.y))
-                .collect();
-            let closed = pl.is_closed();
-            if closed && points.len() > 1 && points.last() == points.first() {
-                points.pop();
-            }
-            let lines = vec![1; points.len()];
-            Ok((
-                Raw::Points {
-                    points,
-                    lines,
-                    closed,
-                },
-                z,
-            ))
-        }
-        EntityType::Spline(sp) => {
-            extrusion(&sp.normal)?;
-            if sp.control_points.is_empty() {
-                let Ok(z) = planar(&mut sp.fit_points.iter().map(|p| p.z)) else {
-                    let pts = sp.fit_points.iter().map(|p| [p.x, p.y, p.z]).collect();
-                    return space(pts, sp.is_closed());
-                };
-                let mut points: Vec<Point> =
-                    sp.fit_points.iter().map(|p| Point::new(p.x, p.y)).collect();
-                let closed = sp.is_closed();
-                if closed && points.len() > 1 && points.last() == points.first() {
-                    points.pop();
-                }
-                let lines = vec![1; points.len()];
-                return Ok((
-                    Raw::Points {
-                        points,
-                        lines,
-                        closed,
-                    },
-                    z,
-                ));
-            }
-            let z = planar(&mut sp.control_points.iter().map(|p| p.z)).map_err(|(a, b)| {
-                err(format!(
-                    "z varies ({a} and {b}): a 3-D B-spline is not taken (a 3-D POLYLINE or \
-                     SPLINE fit points are, as a space curve)"
-                ))
-            })?;
-            let degree = usize::try_from(sp.degree_of_curve)
-                .map_err(|_| err(format!("degree {} is not a degree", sp.degree_of_curve)))?;
-            let ctrl: Vec<Point> = sp
-                .control_points
-                .iter()
-                .map(|p| Point::new(p.x, p.y))
-                .collect();
-            let weights = if sp.weight_values.is_empty() {
-                None
-            } else {
-                Some(sp.weight_values.clone())
-            };
-            let curve = KnotVector::try_new(sp.knot_values.clone())
-                .and_then(|k| BSplineCurve::try_new(degree, k, ctrl, weights))
-                .map_err(|e| err(e.to_string()))?;
-            Ok((Raw::Curve(curve), z))
-        }
+        EntityType::LwPolyline(lw) => lw_polyline_curve(lw, e.common.elevation, &err),
+        EntityType::Polyline(pl) => polyline_curve(pl, &err),
+        EntityType::Spline(sp) => spline_curve(sp, &err),
         _ => Err(err("not a curve entity".into())),
     }
+}
+
+/// Refuse a curve whose plane is not the world XY plane.
+fn extrusion(v: &dxf::Vector, err: &dyn Fn(String) -> IoError) -> Result<(), IoError> {
+    if v.x == 0.0 && v.y == 0.0 && v.z > 0.0 {
+        Ok(())
+    } else {
+        Err(err(format!(
+            "its plane has the normal ({}, {}, {}); batten takes curves in the world XY plane only",
+            v.x, v.y, v.z
+        )))
+    }
+}
+
+/// The constant z, or the first two values that differ.
+fn planar(zs: &mut dyn Iterator<Item = f64>) -> Result<f64, (f64, f64)> {
+    let mut z0 = None;
+    for z in zs {
+        match z0 {
+            None => z0 = Some(z),
+            Some(a) if a == z => {}
+            Some(a) => return Err((a, z)),
+        }
+    }
+    Ok(z0.unwrap_or(0.0))
+}
+
+/// Space points, a closed entity's repeated first vertex left out.
+fn space(mut points: Vec<Xyz>, closed: bool) -> Result<(Raw, f64), IoError> {
+    if closed && points.len() > 1 && points.last() == points.first() {
+        points.pop();
+    }
+    let lines = vec![1; points.len()];
+    Ok((
+        Raw::Space {
+            points,
+            lines,
+            closed,
+        },
+        0.0,
+    ))
+}
+
+/// Planar points at height `z`, a closed entity's repeated first vertex left out.
+fn plane_points(mut points: Vec<Point>, closed: bool, z: f64) -> Result<(Raw, f64), IoError> {
+    if closed && points.len() > 1 && points.last() == points.first() {
+        points.pop();
+    }
+    let lines = vec![1; points.len()];
+    Ok((
+        Raw::Points {
+            points,
+            lines,
+            closed,
+        },
+        z,
+    ))
+}
+
+/// An arc segment's error: vertex `i` (0-based) has a bulge.
+fn bulge_error(i: usize, err: &dyn Fn(String) -> IoError) -> IoError {
+    err(format!(
+        "vertex {} starts an arc segment (bulge); batten takes straight segments only",
+        i + 1
+    ))
+}
+
+/// An LWPOLYLINE's points, at its elevation.
+fn lw_polyline_curve(
+    lw: &LwPolyline,
+    elevation: f64,
+    err: &dyn Fn(String) -> IoError,
+) -> Result<(Raw, f64), IoError> {
+    extrusion(&lw.extrusion_direction, err)?;
+    if let Some(i) = lw.vertices.iter().position(|v| v.bulge != 0.0) {
+        return Err(bulge_error(i, err));
+    }
+    let points: Vec<Point> = lw.vertices.iter().map(|v| Point::new(v.x, v.y)).collect();
+    plane_points(points, lw.is_closed(), elevation)
+}
+
+/// A POLYLINE's points (its frame vertices left out): planar, or space points when a 3-D
+/// polyline's z varies.
+fn polyline_curve(pl: &Polyline, err: &dyn Fn(String) -> IoError) -> Result<(Raw, f64), IoError> {
+    extrusion(&pl.normal, err)?;
+    let verts: Vec<_> = pl
+        .vertices()
+        .filter(|v| v.flags & VERTEX_FRAME == 0)
+        .collect();
+    if let Some(i) = verts.iter().position(|v| v.bulge != 0.0) {
+        return Err(bulge_error(i, err));
+    }
+    let z = if pl.flags & POLYLINE_3D != 0 {
+        match planar(&mut verts.iter().map(|v| v.location.z)) {
+            Ok(z) => z,
+            Err(_) => {
+                let pts = verts
+                    .iter()
+                    .map(|v| [v.location.x, v.location.y, v.location.z])
+                    .collect();
+                return space(pts, pl.is_closed());
+            }
+        }
+    } else {
+        pl.location.z
+    };
+    let points: Vec<Point> = verts
+        .iter()
+        .map(|v| Point::new(v.location.x, v.location.y))
+        .collect();
+    plane_points(points, pl.is_closed(), z)
+}
+
+/// A SPLINE: its control points as a B-spline, or, with fit points only, those points
+/// (space points when their z varies).
+fn spline_curve(sp: &Spline, err: &dyn Fn(String) -> IoError) -> Result<(Raw, f64), IoError> {
+    extrusion(&sp.normal, err)?;
+    if sp.control_points.is_empty() {
+        let Ok(z) = planar(&mut sp.fit_points.iter().map(|p| p.z)) else {
+            let pts = sp.fit_points.iter().map(|p| [p.x, p.y, p.z]).collect();
+            return space(pts, sp.is_closed());
+        };
+        let points: Vec<Point> = sp.fit_points.iter().map(|p| Point::new(p.x, p.y)).collect();
+        return plane_points(points, sp.is_closed(), z);
+    }
+    let z = planar(&mut sp.control_points.iter().map(|p| p.z)).map_err(|(a, b)| {
+        err(format!(
+            "z varies ({a} and {b}): a 3-D B-spline is not taken (a 3-D POLYLINE or \
+             SPLINE fit points are, as a space curve)"
+        ))
+    })?;
+    let degree = usize::try_from(sp.degree_of_curve)
+        .map_err(|_| err(format!("degree {} is not a degree", sp.degree_of_curve)))?;
+    let ctrl: Vec<Point> = sp
+        .control_points
+        .iter()
+        .map(|p| Point::new(p.x, p.y))
+        .collect();
+    let weights = if sp.weight_values.is_empty() {
+        None
+    } else {
+        Some(sp.weight_values.clone())
+    };
+    let curve = KnotVector::try_new(sp.knot_values.clone())
+        .and_then(|k| BSplineCurve::try_new(degree, k, ctrl, weights))
+        .map_err(|e| err(e.to_string()))?;
+    Ok((Raw::Curve(curve), z))
 }
 
 /// The origin of a found entity: its handle, layer and z.

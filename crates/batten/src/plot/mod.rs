@@ -403,11 +403,13 @@ pub fn render(
     if stacked && let Some(t) = &options.title {
         svg.text(options.width / 2.0, 24.0, "bt-title", "middle", t);
     }
-    let title_for = |default: &str| -> String {
-        match (&options.title, stacked) {
-            (Some(t), false) => t.clone(),
-            _ => default.to_string(),
-        }
+    let page = Page {
+        input,
+        faired,
+        series: &series,
+        xc: xc.as_ref(),
+        options,
+        stacked,
     };
     for (row, kind) in kinds.iter().enumerate() {
         let outer = Rect {
@@ -416,67 +418,7 @@ pub fn render(
             w: options.width,
             h: options.height,
         };
-        match kind {
-            PlotKind::Comb => {
-                let scale = match options.comb_scale {
-                    Some(s) => s,
-                    None => scale_for(
-                        input,
-                        series
-                            .iter()
-                            .map(|s| panels::max_drawn_curvature(s))
-                            .fold(0.0, f64::max),
-                    ),
-                };
-                panels::comb(
-                    &mut svg,
-                    outer,
-                    &series,
-                    scale,
-                    &title_for("Curvature comb"),
-                );
-            }
-            PlotKind::Curvature => panels::curvature(
-                &mut svg,
-                outer,
-                &series,
-                &title_for("Curvature κ against arc length"),
-            ),
-            PlotKind::Radius => {
-                let rho_max = options.rho_max.unwrap_or_else(|| input.scale());
-                panels::radius(
-                    &mut svg,
-                    outer,
-                    &series,
-                    rho_max,
-                    &title_for("Radius of curvature ρ = 1/κ against arc length"),
-                );
-            }
-            PlotKind::Xc => {
-                if let Some((data, chord)) = &xc {
-                    let s: Vec<(usize, &XcData)> = data.iter().map(|(k, d)| (*k, d)).collect();
-                    panels::xc(
-                        &mut svg,
-                        outer,
-                        &s,
-                        *chord,
-                        &title_for("x–c plot (Han): c = y″/6 of the cubic spline function"),
-                    );
-                }
-            }
-            PlotKind::Displacement => {
-                if let Some(f) = faired {
-                    panels::displacement(
-                        &mut svg,
-                        outer,
-                        input.points(),
-                        f.points(),
-                        &title_for("Displacement of each point"),
-                    );
-                }
-            }
-            PlotKind::All => {}
-        }
+        page.panel(&mut svg, *kind, outer);
     }
     let top = heading + options.height * kinds.len() as f64;
     for (i, n) in notes.iter().enumerate() {
@@ -489,6 +431,87 @@ pub fn render(
         );
     }
     Ok(svg.finish())
+}
+
+/// What every panel of one [`render`] draws from.
+struct Page<'a> {
+    input: &'a PointSeq,
+    faired: Option<&'a PointSeq>,
+    series: &'a [&'a Sampled<'a>],
+    xc: Option<&'a (Vec<(usize, XcData)>, bool)>,
+    options: &'a PlotOptions,
+    /// Whether the panels are stacked under one heading ([`PlotKind::All`]).
+    stacked: bool,
+}
+
+impl Page<'_> {
+    /// A panel's title: the user's title for a single panel, else `default`.
+    fn title_for(&self, default: &str) -> String {
+        match (&self.options.title, self.stacked) {
+            (Some(t), false) => t.clone(),
+            _ => default.to_string(),
+        }
+    }
+
+    /// Draw the panel of `kind` in `outer`.
+    fn panel(&self, svg: &mut Svg, kind: PlotKind, outer: Rect) {
+        let (input, series, options) = (self.input, self.series, self.options);
+        match kind {
+            PlotKind::Comb => {
+                let scale = match options.comb_scale {
+                    Some(s) => s,
+                    None => scale_for(
+                        input,
+                        series
+                            .iter()
+                            .map(|s| panels::max_drawn_curvature(s))
+                            .fold(0.0, f64::max),
+                    ),
+                };
+                panels::comb(svg, outer, series, scale, &self.title_for("Curvature comb"));
+            }
+            PlotKind::Curvature => panels::curvature(
+                svg,
+                outer,
+                series,
+                &self.title_for("Curvature κ against arc length"),
+            ),
+            PlotKind::Radius => {
+                let rho_max = options.rho_max.unwrap_or_else(|| input.scale());
+                panels::radius(
+                    svg,
+                    outer,
+                    series,
+                    rho_max,
+                    &self.title_for("Radius of curvature ρ = 1/κ against arc length"),
+                );
+            }
+            PlotKind::Xc => {
+                if let Some((data, chord)) = self.xc {
+                    let s: Vec<(usize, &XcData)> = data.iter().map(|(k, d)| (*k, d)).collect();
+                    panels::xc(
+                        svg,
+                        outer,
+                        &s,
+                        *chord,
+                        &self.title_for("x–c plot (Han): c = y″/6 of the cubic spline function"),
+                    );
+                }
+            }
+            PlotKind::Displacement => {
+                if let Some(f) = self.faired {
+                    panels::displacement(
+                        svg,
+                        outer,
+                        input.points(),
+                        f.points(),
+                        &self.title_for("Displacement of each point"),
+                    );
+                }
+            }
+            PlotKind::All => {}
+        }
+    }
 }
 
 /// The x–c data of the input and, when it is a function in the same frame, the faired

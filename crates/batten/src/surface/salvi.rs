@@ -33,7 +33,9 @@ use std::ops::Range;
 use serde_json::json;
 
 use super::fairing::{MethodRun, Problem, tabu_length};
-use super::patch::{Homogeneous, SurfaceCurvature, Xyz, curvature_of, distance, rational_derivs};
+use super::patch::{
+    BSplineSurface, Homogeneous, SurfaceCurvature, Xyz, curvature_of, distance, rational_derivs,
+};
 use super::sample::{SAMPLES_PER_SPAN, SampleGrid};
 use super::target::{TargetParams, Targets};
 use crate::error::Result;
@@ -193,47 +195,7 @@ pub(crate) fn run(
 ) -> Result<MethodRun> {
     let s = p.surface;
     let (nu, nv) = s.size();
-    let (du, dv) = s.degree();
-    let (ku, kv) = s.knots();
-    let range_u = support_ranges(ku, du, nu, &grid.u)?;
-    let range_v = support_ranges(kv, dv, nv, &grid.v)?;
-    let bu: Vec<_> = grid.u.iter().map(|&u| s.basis_u(u)).collect();
-    let bv: Vec<_> = grid.v.iter().map(|&v| s.basis_v(v)).collect();
-    let mut homog = Vec::with_capacity(grid.len());
-    for b in &bu {
-        for c in &bv {
-            homog.push(s.homogeneous(b, c, 2));
-        }
-    }
-    let curv: Vec<_> = homog
-        .iter()
-        .map(|h| curvature_of(&rational_derivs(h)))
-        .collect();
-    let valid: Vec<bool> = curv.iter().map(Option::is_some).collect();
-    let kappa_max = curv
-        .iter()
-        .flatten()
-        .fold(0.0f64, |m, c| m.max(c.kappa1.abs()).max(c.kappa2.abs()));
-    let n_valid = valid.iter().filter(|&&v| v).count() as f64;
-    let floor = n_valid * (PI_HAT_FLOOR_REL * kappa_max).powi(2);
-    let residual: Vec<f64> = curv
-        .iter()
-        .enumerate()
-        .map(|(k, c)| targets.residual(k, c.as_ref()))
-        .collect();
-    let mut st = State {
-        nv,
-        n_sv: grid.v.len(),
-        weights: s.weights(),
-        bu,
-        bv,
-        range_u,
-        range_v,
-        homog,
-        residual,
-        valid,
-        targets,
-    };
+    let (mut st, floor) = State::sample(s, grid, targets)?;
     let original = s.control_points().to_vec();
     let mut control = original.clone();
     let max_iter = p.max_iterations.unwrap_or(DEFAULT_MAX_ITERATIONS);
@@ -267,30 +229,8 @@ pub(crate) fn run(
         let Some(k) = select_candidate(&dev, &p.movable, &mut recent) else {
             break;
         };
-        let (i, j) = (k / nv, k % nv);
         recent.push(k);
-        let here = control[k];
-        let orig = original[k];
-        let step = SIMPLEX_STEP_REL * neighbour_spacing(&control, nu, nv, i, j).unwrap_or(p.delta);
-        let target = |d: &Xyz| {
-            let (c, _) = clamp_to_original(
-                &orig,
-                &[here[0] + d[0], here[1] + d[1], here[2] + d[2]],
-                p.delta,
-            );
-            [c[0] - here[0], c[1] - here[1], c[2] - here[2]]
-        };
-        let support = st.support(i, j);
-        let current = st.local(&support, [0.0; 3]);
-        let nm = NelderMeadParams::with_scaled_step(step)
-            .with_xatol(SIMPLEX_XATOL_REL * step)
-            .with_max_evaluations(params.simplex_evaluations);
-        let best = minimize_nelder_mead(|d| st.local(&support, target(d)), [0.0; 3], &nm);
-        let delta = target(&best.x);
-        let value = st.local(&support, delta);
-        if value < current && delta != [0.0; 3] {
-            st.apply(i, j, delta);
-            control[k] = [here[0] + delta[0], here[1] + delta[1], here[2] + delta[2]];
+        if st.improve(p, params, &mut control, &original, k) {
             total = st.residual.iter().sum();
             moves += 1;
         } else {
@@ -298,6 +238,23 @@ pub(crate) fn run(
         }
         history.push(total);
     }
+    Ok(MethodRun {
+        control,
+        moves,
+        rejected,
+        status: Some(status),
+        history,
+        parameters: run_parameters(params, grid, tabu, max_iter),
+    })
+}
+
+/// The parameters a run reports.
+fn run_parameters(
+    params: &SalviSurfaceParams,
+    grid: &SampleGrid,
+    tabu: usize,
+    max_iter: usize,
+) -> BTreeMap<String, serde_json::Value> {
     let mut parameters = BTreeMap::new();
     parameters.insert("samples_per_span".into(), json!(params.samples_per_span));
     parameters.insert("samples".into(), json!([grid.u.len(), grid.v.len()]));
@@ -310,14 +267,101 @@ pub(crate) fn run(
     );
     parameters.insert("tabu".into(), json!(tabu));
     parameters.insert("max_iterations".into(), json!(max_iter));
-    Ok(MethodRun {
-        control,
-        moves,
-        rejected,
-        status: Some(status),
-        history,
-        parameters,
-    })
+    parameters
+}
+
+impl<'a> State<'a> {
+    /// The surface sampled on the grid, with each sample's residual; and the total residual
+    /// below which the run stops (curvature at rounding level).
+    fn sample(
+        s: &'a BSplineSurface,
+        grid: &SampleGrid,
+        targets: &'a Targets,
+    ) -> Result<(State<'a>, f64)> {
+        let (nu, nv) = s.size();
+        let (du, dv) = s.degree();
+        let (ku, kv) = s.knots();
+        let range_u = support_ranges(ku, du, nu, &grid.u)?;
+        let range_v = support_ranges(kv, dv, nv, &grid.v)?;
+        let bu: Vec<_> = grid.u.iter().map(|&u| s.basis_u(u)).collect();
+        let bv: Vec<_> = grid.v.iter().map(|&v| s.basis_v(v)).collect();
+        let mut homog = Vec::with_capacity(grid.len());
+        for b in &bu {
+            for c in &bv {
+                homog.push(s.homogeneous(b, c, 2));
+            }
+        }
+        let curv: Vec<_> = homog
+            .iter()
+            .map(|h| curvature_of(&rational_derivs(h)))
+            .collect();
+        let valid: Vec<bool> = curv.iter().map(Option::is_some).collect();
+        let kappa_max = curv
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, c| m.max(c.kappa1.abs()).max(c.kappa2.abs()));
+        let n_valid = valid.iter().filter(|&&v| v).count() as f64;
+        let floor = n_valid * (PI_HAT_FLOOR_REL * kappa_max).powi(2);
+        let residual: Vec<f64> = curv
+            .iter()
+            .enumerate()
+            .map(|(k, c)| targets.residual(k, c.as_ref()))
+            .collect();
+        let st = State {
+            nv,
+            n_sv: grid.v.len(),
+            weights: s.weights(),
+            bu,
+            bv,
+            range_u,
+            range_v,
+            homog,
+            residual,
+            valid,
+            targets,
+        };
+        Ok((st, floor))
+    }
+
+    /// Move control point `k` to where the local simplex search lowers its support's
+    /// residual most, within δ of its original place; whether it moved.
+    fn improve(
+        &mut self,
+        p: &Problem<'_>,
+        params: &SalviSurfaceParams,
+        control: &mut [Xyz],
+        original: &[Xyz],
+        k: usize,
+    ) -> bool {
+        let (nu, nv) = p.surface.size();
+        let (i, j) = (k / nv, k % nv);
+        let here = control[k];
+        let orig = original[k];
+        let step = SIMPLEX_STEP_REL * neighbour_spacing(control, nu, nv, i, j).unwrap_or(p.delta);
+        let target = |d: &Xyz| {
+            let (c, _) = clamp_to_original(
+                &orig,
+                &[here[0] + d[0], here[1] + d[1], here[2] + d[2]],
+                p.delta,
+            );
+            [c[0] - here[0], c[1] - here[1], c[2] - here[2]]
+        };
+        let support = self.support(i, j);
+        let current = self.local(&support, [0.0; 3]);
+        let nm = NelderMeadParams::with_scaled_step(step)
+            .with_xatol(SIMPLEX_XATOL_REL * step)
+            .with_max_evaluations(params.simplex_evaluations);
+        let best = minimize_nelder_mead(|d| self.local(&support, target(d)), [0.0; 3], &nm);
+        let delta = target(&best.x);
+        let value = self.local(&support, delta);
+        if value < current && delta != [0.0; 3] {
+            self.apply(i, j, delta);
+            control[k] = [here[0] + delta[0], here[1] + delta[1], here[2] + delta[2]];
+            true
+        } else {
+            false
+        }
+    }
 }
 
 /// The mean distance from `P_ij` to its (up to four) neighbours in the net; `None` when they

@@ -292,14 +292,8 @@ fn fair_points<const D: usize>(
     let n = pts.len();
     // The input in units of the tolerance, about its centroid (the energy ignores
     // translation; centring keeps the numbers small).
-    let mut centre = [0.0; D];
-    for p in pts {
-        for a in 0..D {
-            centre[a] += p[a] / n as f64;
-        }
-    }
-    let scale =
-        |p: &[f64; D]| -> [f64; D] { std::array::from_fn(|a| (p[a] - centre[a]) / tolerance) };
+    let centre = centroid(pts);
+    let scale = |p: &[f64; D]| -> [f64; D] { in_units(p, &centre, tolerance) };
     let scaled: Vec<f64> = pts.iter().flat_map(scale).collect();
     let held_ends = held.iter().take_while(|h| **h).count();
     let dense = n > DENSE_POINTS && held_ends <= 1;
@@ -323,67 +317,30 @@ fn fair_points<const D: usize>(
     let spline_form = spline.is_some();
     let form = spline.unwrap_or_else(|| Form::points(held, chords, closed));
     let mut reference = form.first_reference(shape.iter().flat_map(scale).collect());
-    let mut history = Vec::with_capacity(params.passes);
-    let mut iterations = 0;
-    let mut converged = true;
-    let mut stalled = None;
-    let mut gap = 0.0;
-    // Each stage: one solve from the current reference, the result put into the band, a
-    // history row (`stage` counts from 1: the passes, then the debiasing stage).
-    let mut record = |sol: &solver::Solution, stage: usize, shape: &mut Vec<[f64; D]>| {
-        iterations += sol.iterations;
-        converged &= sol.converged;
-        if !sol.converged && sol.iterations < params.max_iterations {
-            // Stopped by rounding, not by the iteration limit: keep the worst stage's gap.
-            stalled = Some(stalled.map_or(sol.gap, |g: f64| g.max(sol.gap)));
-        }
-        gap = sol.gap;
-        *shape = into_band(pts, &sol.r, tolerance);
-        history.push(HistoryRow {
-            iteration: stage,
-            measure: sol.objective,
-            max_distance: farthest(shape, pts),
-        });
+    let mut stages = Stages {
+        pts,
+        tolerance,
+        max_iterations: params.max_iterations,
+        history: Vec::with_capacity(params.passes),
+        iterations: 0,
+        converged: true,
+        stalled: None,
+        gap: 0.0,
     };
     for pass in 0..params.passes {
         let energy = form.energy(&shape, &reference, pass_metric(pass, params));
         let problem = band_problem(&form, &energy, &reference, &scaled, params.max_iterations);
         let sol = solve(&problem)?;
-        record(&sol, pass + 1, &mut shape);
+        stages.record(&sol, pass + 1, &mut shape);
         reference = form.next_reference(&reference, &scaled, &sol);
     }
     let mut fidelity = None;
     if params.fit > 0.0 && noise_sigma > 0.0 {
-        // The last pass's metric, its tangents re-taken from the passes' result.
-        let metric = pass_metric(params.passes - 1, params);
-        let energy = form.energy(&shape, &reference, metric);
-        let mut problem = band_problem(&form, &energy, &reference, &scaled, params.max_iterations);
-        let fixed = form.fixed(&problem.centres);
-        let fit = Penalized::new(
-            &energy,
-            form.unit(),
-            &form.design,
-            &form.held,
-            &form.pinned,
-            &fixed,
-            &problem.anchor,
-            &problem.centres,
-        );
-        let scaled_noise = params.fit * noise_sigma / tolerance;
-        let target = noise_dims as f64 * scaled_noise * scaled_noise;
-        let anchor_energy = problem.anchor_energy;
-        let cap = ENERGY_CAP * anchor_energy;
-        if let Some(mu) = fit.discrepancy_weight(anchor_energy, target, cap)? {
-            let (weights, raised) = fit.local_weights(
-                mu,
-                anchor_energy,
-                cap,
-                noise_sigma / tolerance,
-                params.local,
-            )?;
-            problem.fidelity = weights;
-            let sol = solve(&problem)?;
-            record(&sol, params.passes + 1, &mut shape);
+        let noise = (noise_sigma, noise_dims);
+        if let Some((sol, mu, raised)) =
+            debias_stage(&form, &shape, &reference, &scaled, tolerance, noise, params)?
+        {
+            stages.record(&sol, params.passes + 1, &mut shape);
             // Reported in the point form's units.
             fidelity = Some((mu / form.unit(), raised));
         }
@@ -395,17 +352,113 @@ fn fair_points<const D: usize>(
         .count();
     Ok(Faired {
         points: shape,
-        converged,
-        stalled,
-        history,
+        converged: stages.converged,
+        stalled: stages.stalled,
+        history: stages.history,
         fidelity,
         spline: spline_form.then(|| form.vars()),
         solver: SolverInfo {
-            iterations,
-            duality_gap: gap,
+            iterations: stages.iterations,
+            duality_gap: stages.gap,
             points_on_band_edge: on_edge,
         },
     })
+}
+
+/// The centroid of the points.
+fn centroid<const D: usize>(pts: &[[f64; D]]) -> [f64; D] {
+    let n = pts.len();
+    let mut centre = [0.0; D];
+    for p in pts {
+        for a in 0..D {
+            centre[a] += p[a] / n as f64;
+        }
+    }
+    centre
+}
+
+/// A point in units of the tolerance, about `centre`.
+fn in_units<const D: usize>(p: &[f64; D], centre: &[f64; D], tolerance: f64) -> [f64; D] {
+    std::array::from_fn(|a| (p[a] - centre[a]) / tolerance)
+}
+
+/// What the stages of [`fair_points`] add up to.
+struct Stages<'p, const D: usize> {
+    pts: &'p [[f64; D]],
+    tolerance: f64,
+    max_iterations: usize,
+    history: Vec<HistoryRow>,
+    iterations: usize,
+    converged: bool,
+    stalled: Option<f64>,
+    gap: f64,
+}
+
+impl<const D: usize> Stages<'_, D> {
+    /// Each stage: one solve from the current reference, the result put into the band, a
+    /// history row (`stage` counts from 1: the passes, then the debiasing stage).
+    fn record(&mut self, sol: &solver::Solution, stage: usize, shape: &mut Vec<[f64; D]>) {
+        self.iterations += sol.iterations;
+        self.converged &= sol.converged;
+        if !sol.converged && sol.iterations < self.max_iterations {
+            // Stopped by rounding, not by the iteration limit: keep the worst stage's gap.
+            self.stalled = Some(self.stalled.map_or(sol.gap, |g: f64| g.max(sol.gap)));
+        }
+        self.gap = sol.gap;
+        *shape = into_band(self.pts, &sol.r, self.tolerance);
+        self.history.push(HistoryRow {
+            iteration: stage,
+            measure: sol.objective,
+            max_distance: farthest(shape, self.pts),
+        });
+    }
+}
+
+/// The debiasing stage: the last pass's problem with a data term weighted for the noise
+/// level (`noise`: σ̂ and the coordinates it lies in), solved; `None` when no weight is
+/// needed. With the solution, the weight μ and the number of points whose weight was
+/// raised locally.
+fn debias_stage<const D: usize>(
+    form: &Form<D>,
+    shape: &[[f64; D]],
+    reference: &[f64],
+    scaled: &[f64],
+    tolerance: f64,
+    (noise_sigma, noise_dims): (f64, usize),
+    params: &BandParams,
+) -> Result<Option<(solver::Solution, f64, usize)>> {
+    // The last pass's metric, its tangents re-taken from the passes' result.
+    let metric = pass_metric(params.passes - 1, params);
+    let energy = form.energy(shape, reference, metric);
+    let mut problem = band_problem(form, &energy, reference, scaled, params.max_iterations);
+    let fixed = form.fixed(&problem.centres);
+    let fit = Penalized::new(
+        &energy,
+        form.unit(),
+        &form.design,
+        &form.held,
+        &form.pinned,
+        &fixed,
+        &problem.anchor,
+        &problem.centres,
+    );
+    let scaled_noise = params.fit * noise_sigma / tolerance;
+    let target = noise_dims as f64 * scaled_noise * scaled_noise;
+    let anchor_energy = problem.anchor_energy;
+    let cap = ENERGY_CAP * anchor_energy;
+    let Some(mu) = fit.discrepancy_weight(anchor_energy, target, cap)? else {
+        return Ok(None);
+    };
+    let (weights, raised) = fit.local_weights(
+        mu,
+        anchor_energy,
+        cap,
+        noise_sigma / tolerance,
+        params.local,
+    )?;
+    problem.fidelity = weights;
+    let sol = solve(&problem)?;
+    Ok(Some((sol, mu, raised)))
 }
 
 /// The metric of pass `pass` (from 0): the jerk first, then the parameters' metric.

@@ -328,131 +328,20 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
 /// # Errors
 /// As [`solve`].
 pub(super) fn solve_all<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
-    let energy = p.energy;
-    let design = p.design;
-    // `n` points (constraints), `dim` unknowns.
-    let n = design.points();
-    let dim = design.vars() * D;
-    let (held, pinned) = (p.held, p.pinned);
-    let free = pinned.iter().filter(|h| !**h).count();
-    let y = match &p.start {
-        Some(y) => y.clone(),
-        None => start::<D>(&p.centres, pinned),
-    };
-    let mut off = vec![0.0; n * D];
-    design.eval::<D>(&y, &mut off);
-    for (o, c) in off.iter_mut().zip(&p.centres) {
-        *o -= c;
-    }
-    let sig: Vec<f64> = (0..n)
-        .map(|i| {
-            if pinned[i] {
-                1.0
-            } else {
-                -constraint(&off[i * D..(i + 1) * D])
-            }
-        })
-        .collect();
-    if sig.iter().any(|s| *s <= 0.0) {
-        return Err(Error::InvalidParameter {
-            name: "band".into(),
-            reason: "the solver's start is not strictly inside the band".into(),
-        });
-    }
-    let mut st = State::<D> {
-        y,
-        off,
-        lam: pinned.iter().map(|h| if *h { 0.0 } else { 1.0 }).collect(),
-        sig,
-    };
-    let mut newton = Newton::new(energy, held);
-    // The largest row sum of `|A|`.
-    let a_abs = {
-        let mut rows = vec![0.0_f64; dim];
-        energy.for_each_lower(1.0, |r, c, v| {
-            rows[r] += v.abs();
-            if r != c {
-                rows[c] += v.abs();
-            }
-        });
-        norm_inf(&rows)
-    };
-    let mut blocks = vec![[[0.0; D]; D]; n];
-    let mut ay = vec![0.0; dim];
-    let mut grad = vec![0.0; dim];
-    let mut rd = vec![0.0; dim];
-    let mut rc = vec![0.0; n];
-    let mut rp = vec![0.0; n];
-    let mut dy = vec![0.0; dim];
-    let mut dr = vec![0.0; n * D];
-    let mut dlam = vec![0.0; n];
-    let mut dsig = vec![0.0; n];
-    let mut work = Work {
-        vars: vec![0.0; dim],
-        points: vec![0.0; n * D],
-        rhs: vec![0.0; dim],
-    };
-    // The constraint and data terms of the dual residual, per point.
-    let mut pull = vec![0.0; n * D];
-
-    let weight = |i: usize| p.fidelity.get(i).copied().unwrap_or(0.0);
-    let objective = |y: &[f64], ay: &[f64], off: &[f64]| -> f64 {
-        let quad: f64 = y.iter().zip(ay).map(|(x, v)| x * v).sum();
-        let lin: f64 = y.iter().zip(&p.anchor).map(|(x, v)| x * v).sum();
-        let data: f64 = off
-            .iter()
-            .enumerate()
-            .map(|(k, r)| weight(k / D) * r * r)
-            .sum();
-        p.anchor_energy + 2.0 * lin + quad + data
-    };
-
+    let mut ipm = Ipm::start(p)?;
+    let free = ipm.free;
     let mut iterations = 0;
     let mut converged = free == 0;
     let mut last_gap = 0.0;
     let mut stalls = 0;
     // Nothing to solve when every point is held.
     while free > 0 && iterations <= p.max_iterations {
-        // Residuals at (y, λ, σ).
-        ay.fill(0.0);
-        energy.apply_add(&st.y, &mut ay);
-        for k in 0..dim {
-            grad[k] = 2.0 * (ay[k] + p.anchor[k]);
-        }
-        let mut gap = 0.0;
-        for i in 0..n {
-            if pinned[i] {
-                for a in 0..D {
-                    pull[i * D + a] = 0.0;
-                }
-                continue;
-            }
-            // Every iterate is strictly inside the band (the step below keeps it there), so
-            // the slack is the constraint's own value and the primal residual is zero.
-            st.sig[i] = -constraint(&st.off[i * D..(i + 1) * D]);
-            gap += st.lam[i] * st.sig[i];
-            for a in 0..D {
-                let k = i * D + a;
-                pull[k] = 2.0 * (st.lam[i] + weight(i)) * st.off[k];
-            }
-        }
-        rd.copy_from_slice(&grad);
-        design.eval_t_add::<D>(&pull, &mut rd);
-        for (k, r) in rd.iter_mut().enumerate() {
-            if held[k / D] {
-                *r = 0.0;
-            }
-        }
-        let f = objective(&st.y, &ay, &st.off);
-        let scale = f.abs().max(OBJECTIVE_FLOOR * free as f64);
+        let Residuals {
+            gap,
+            scale,
+            dual_ok,
+        } = ipm.residuals();
         last_gap = gap / scale;
-        // The dual residual is measured against the size of the terms that make it up
-        // (`|A| |y|` bounds the rounding of `A y`), so that its rounding floor counts as zero.
-        let terms = (2.0 * a_abs * norm_inf(&st.y))
-            .max(2.0 * norm_inf(&p.anchor))
-            .max(norm_inf(&grad))
-            .max(GRADIENT_FLOOR);
-        let dual_ok = norm_inf(&rd) <= DUAL_RESIDUAL_REL * terms;
         if gap <= GAP_REL * scale && dual_ok {
             converged = true;
             break;
@@ -463,61 +352,15 @@ pub(super) fn solve_all<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> 
         iterations += 1;
         let mu = gap / free as f64;
 
-        // The Newton matrix `2A + Σ [2λ_i I + (4λ_i/σ_i) r_i r_iᵀ]`, factorised once for
-        // both the predictor and the corrector.
-        for i in 0..n {
-            blocks[i] = [[0.0; D]; D];
-            if pinned[i] {
-                continue;
-            }
-            let w = 4.0 * st.lam[i] / st.sig[i];
-            for a in 0..D {
-                for c in 0..D {
-                    let id = if a == c {
-                        2.0 * (st.lam[i] + weight(i))
-                    } else {
-                        0.0
-                    };
-                    blocks[i][a][c] = id + w * st.off[i * D + a] * st.off[i * D + c];
-                }
-            }
-        }
         // The iterate is strictly feasible at every step: if rounding makes the Newton system
         // unusable (a non-finite pivot or direction, possible only near the end when many
         // multipliers and slacks are both tiny), the run stops there with what it has.
-        if newton.factorize(p, &blocks).is_err() {
+        if ipm.factorize().is_err() {
             break;
         }
-
-        // Predictor (affine scaling): complementarity target 0, constraint target 0.
-        for i in 0..n {
-            rc[i] = if pinned[i] {
-                0.0
-            } else {
-                st.lam[i] * st.sig[i]
-            };
-        }
-        rp.fill(0.0);
-        let mut step = Step {
-            dy: &mut dy,
-            dr: &mut dr,
-            dlam: &mut dlam,
-            dsig: &mut dsig,
+        let Ok((alpha_aff, gap_aff)) = ipm.predictor() else {
+            break;
         };
-        if direction(
-            p, &newton, &blocks, &st, &rd, &rp, &rc, &mut step, &mut work,
-        )
-        .is_err()
-        {
-            break;
-        }
-        let alpha_aff = step_length(&st.lam, &dlam, &st.sig, &dsig, pinned);
-        let mut gap_aff = 0.0;
-        for i in 0..n {
-            if !pinned[i] {
-                gap_aff += (st.lam[i] + alpha_aff * dlam[i]) * (st.sig[i] + alpha_aff * dsig[i]);
-            }
-        }
         let centring = (gap_aff / gap).clamp(0.0, 1.0).powi(3);
         // The gap aimed at: Mehrotra's, but not below a tenth of the stopping rule's. Once the
         // gap meets the rule, what is left is the dual residual, which full steps at the same
@@ -525,46 +368,10 @@ pub(super) fn solve_all<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> 
         // singular (λ/σ without bound at the band's edge), and the residual then stays where
         // rounding leaves it while the points drift along the energy's flattest directions.
         let target = (centring * mu).max(GAP_TARGET_FLOOR * GAP_REL * scale / free as f64);
-
-        // Corrector: the second-order terms of the predictor, centred at `centring · μ`. Two
-        // of them: `Δλ Δσ` in the complementarity (Mehrotra) and `|Δr|²` in the constraint,
-        // which is what a point sliding along the band's edge loses to the curvature of the
-        // edge (without it such a step leaves the band and is cut short).
-        for i in 0..n {
-            if pinned[i] {
-                rc[i] = 0.0;
-                rp[i] = 0.0;
-                continue;
-            }
-            rc[i] = st.lam[i] * st.sig[i] + dlam[i] * dsig[i] - target;
-            let slide: f64 = (0..D).map(|a| dr[i * D + a] * dr[i * D + a]).sum();
-            rp[i] = alpha_aff * slide;
-        }
-        let mut step = Step {
-            dy: &mut dy,
-            dr: &mut dr,
-            dlam: &mut dlam,
-            dsig: &mut dsig,
-        };
-        if direction(
-            p, &newton, &blocks, &st, &rd, &rp, &rc, &mut step, &mut work,
-        )
-        .is_err()
-        {
+        if ipm.corrector(alpha_aff, target).is_err() {
             break;
         }
-        let mut alpha = step_length(&st.lam, &dlam, &st.sig, &dsig, pinned);
-        // The constraints are curved: a point sliding along the band's edge leaves it at
-        // second order. Shorten the step until every point keeps at least a fraction of its
-        // slack (the same rule as the step to the boundary of the linearised slack).
-        let mut tries = 0;
-        while tries < MAX_BACKTRACKS && !inside(&st, &dr, alpha, pinned) {
-            alpha *= BACKTRACK;
-            tries += 1;
-        }
-        if tries == MAX_BACKTRACKS {
-            alpha = 0.0;
-        }
+        let alpha = ipm.step_size();
         if alpha < MIN_STEP {
             stalls += 1;
             if stalls >= MAX_STALLS {
@@ -573,39 +380,349 @@ pub(super) fn solve_all<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> 
         } else {
             stalls = 0;
         }
-        for k in 0..dim {
-            st.y[k] += alpha * dy[k];
-        }
-        for (o, d) in st.off.iter_mut().zip(&dr) {
-            *o += alpha * d;
-        }
-        for i in 0..n {
-            if !pinned[i] {
-                st.lam[i] += alpha * dlam[i];
-                st.sig[i] += alpha * dsig[i];
-            }
-        }
+        ipm.advance(alpha);
     }
     // Stopped short of the stopping rule (by rounding): still counts as converged when the
     // gap is small enough for the objective to be right to `ACCEPT_GAP_REL`.
     converged |= last_gap <= ACCEPT_GAP_REL;
-    ay.fill(0.0);
-    energy.apply_add(&st.y, &mut ay);
-    // Pinned points sit on their input points by definition; in the spline form the
-    // displacement accumulated over the steps can carry rounding (1e-13 tolerances seen).
-    for (i, _) in pinned.iter().enumerate().filter(|(_, p)| **p) {
-        st.off[i * D..(i + 1) * D].fill(0.0);
+    Ok(ipm.finish(iterations, last_gap, converged))
+}
+
+/// The data term's weight `μ_i` of point `i` (0 without a data term).
+fn weight<const D: usize>(p: &Problem<'_, D>, i: usize) -> f64 {
+    p.fidelity.get(i).copied().unwrap_or(0.0)
+}
+
+/// The objective at `y` (`ay = A y`, `off = B y − c`).
+fn objective<const D: usize>(p: &Problem<'_, D>, y: &[f64], ay: &[f64], off: &[f64]) -> f64 {
+    let quad: f64 = y.iter().zip(ay).map(|(x, v)| x * v).sum();
+    let lin: f64 = y.iter().zip(&p.anchor).map(|(x, v)| x * v).sum();
+    let data: f64 = off
+        .iter()
+        .enumerate()
+        .map(|(k, r)| weight(p, k / D) * r * r)
+        .sum();
+    p.anchor_energy + 2.0 * lin + quad + data
+}
+
+/// What the residuals of an iterate say: the duality gap, the objective's scale it is
+/// measured against, and whether the dual residual is at its rounding floor.
+struct Residuals {
+    gap: f64,
+    scale: f64,
+    dual_ok: bool,
+}
+
+/// One run of the interior-point method: the iterate and the arrays every iteration reuses.
+struct Ipm<'p, 'a, const D: usize> {
+    p: &'p Problem<'a, D>,
+    /// `n` points (constraints), `dim` unknowns.
+    n: usize,
+    dim: usize,
+    /// The points with a band constraint.
+    free: usize,
+    /// The largest row sum of `|A|`.
+    a_abs: f64,
+    st: State<D>,
+    newton: Newton,
+    blocks: Vec<[[f64; D]; D]>,
+    ay: Vec<f64>,
+    grad: Vec<f64>,
+    rd: Vec<f64>,
+    rc: Vec<f64>,
+    rp: Vec<f64>,
+    dy: Vec<f64>,
+    dr: Vec<f64>,
+    dlam: Vec<f64>,
+    dsig: Vec<f64>,
+    work: Work,
+    /// The constraint and data terms of the dual residual, per point.
+    pull: Vec<f64>,
+}
+
+impl<'p, 'a, const D: usize> Ipm<'p, 'a, D> {
+    /// The start: strictly inside the band, multipliers 1.
+    fn start(p: &'p Problem<'a, D>) -> Result<Ipm<'p, 'a, D>> {
+        let energy = p.energy;
+        let design = p.design;
+        let n = design.points();
+        let dim = design.vars() * D;
+        let (held, pinned) = (p.held, p.pinned);
+        let free = pinned.iter().filter(|h| !**h).count();
+        let y = match &p.start {
+            Some(y) => y.clone(),
+            None => start::<D>(&p.centres, pinned),
+        };
+        let mut off = vec![0.0; n * D];
+        design.eval::<D>(&y, &mut off);
+        for (o, c) in off.iter_mut().zip(&p.centres) {
+            *o -= c;
+        }
+        let sig: Vec<f64> = (0..n)
+            .map(|i| {
+                if pinned[i] {
+                    1.0
+                } else {
+                    -constraint(&off[i * D..(i + 1) * D])
+                }
+            })
+            .collect();
+        if sig.iter().any(|s| *s <= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "band".into(),
+                reason: "the solver's start is not strictly inside the band".into(),
+            });
+        }
+        let st = State::<D> {
+            y,
+            off,
+            lam: pinned.iter().map(|h| if *h { 0.0 } else { 1.0 }).collect(),
+            sig,
+        };
+        let newton = Newton::new(energy, held);
+        let a_abs = {
+            let mut rows = vec![0.0_f64; dim];
+            energy.for_each_lower(1.0, |r, c, v| {
+                rows[r] += v.abs();
+                if r != c {
+                    rows[c] += v.abs();
+                }
+            });
+            norm_inf(&rows)
+        };
+        Ok(Ipm {
+            p,
+            n,
+            dim,
+            free,
+            a_abs,
+            st,
+            newton,
+            blocks: vec![[[0.0; D]; D]; n],
+            ay: vec![0.0; dim],
+            grad: vec![0.0; dim],
+            rd: vec![0.0; dim],
+            rc: vec![0.0; n],
+            rp: vec![0.0; n],
+            dy: vec![0.0; dim],
+            dr: vec![0.0; n * D],
+            dlam: vec![0.0; n],
+            dsig: vec![0.0; n],
+            work: Work {
+                vars: vec![0.0; dim],
+                points: vec![0.0; n * D],
+                rhs: vec![0.0; dim],
+            },
+            pull: vec![0.0; n * D],
+        })
     }
-    let objective = objective(&st.y, &ay, &st.off);
-    Ok(Solution {
-        r: st.off,
-        y: st.y,
-        objective,
-        iterations,
-        gap: last_gap,
-        converged,
-        multipliers: st.lam,
-    })
+
+    /// The residuals at (y, λ, σ): the dual residual `rd` and the gap, for the stopping test.
+    fn residuals(&mut self) -> Residuals {
+        let p = self.p;
+        let (n, dim) = (self.n, self.dim);
+        let (held, pinned) = (p.held, p.pinned);
+        let st = &mut self.st;
+        self.ay.fill(0.0);
+        p.energy.apply_add(&st.y, &mut self.ay);
+        for k in 0..dim {
+            self.grad[k] = 2.0 * (self.ay[k] + p.anchor[k]);
+        }
+        let mut gap = 0.0;
+        for i in 0..n {
+            if pinned[i] {
+                for a in 0..D {
+                    self.pull[i * D + a] = 0.0;
+                }
+                continue;
+            }
+            // Every iterate is strictly inside the band (the step below keeps it there), so
+            // the slack is the constraint's own value and the primal residual is zero.
+            st.sig[i] = -constraint(&st.off[i * D..(i + 1) * D]);
+            gap += st.lam[i] * st.sig[i];
+            for a in 0..D {
+                let k = i * D + a;
+                self.pull[k] = 2.0 * (st.lam[i] + weight(p, i)) * st.off[k];
+            }
+        }
+        self.rd.copy_from_slice(&self.grad);
+        p.design.eval_t_add::<D>(&self.pull, &mut self.rd);
+        for (k, r) in self.rd.iter_mut().enumerate() {
+            if held[k / D] {
+                *r = 0.0;
+            }
+        }
+        let f = objective(p, &st.y, &self.ay, &st.off);
+        let scale = f.abs().max(OBJECTIVE_FLOOR * self.free as f64);
+        // The dual residual is measured against the size of the terms that make it up
+        // (`|A| |y|` bounds the rounding of `A y`), so that its rounding floor counts as zero.
+        let terms = (2.0 * self.a_abs * norm_inf(&st.y))
+            .max(2.0 * norm_inf(&p.anchor))
+            .max(norm_inf(&self.grad))
+            .max(GRADIENT_FLOOR);
+        let dual_ok = norm_inf(&self.rd) <= DUAL_RESIDUAL_REL * terms;
+        Residuals {
+            gap,
+            scale,
+            dual_ok,
+        }
+    }
+
+    /// The Newton matrix `2A + Σ [2λ_i I + (4λ_i/σ_i) r_i r_iᵀ]`, factorised once for both
+    /// the predictor and the corrector.
+    fn factorize(&mut self) -> Result<()> {
+        let p = self.p;
+        let pinned = p.pinned;
+        let st = &self.st;
+        for i in 0..self.n {
+            self.blocks[i] = [[0.0; D]; D];
+            if pinned[i] {
+                continue;
+            }
+            let w = 4.0 * st.lam[i] / st.sig[i];
+            for a in 0..D {
+                for c in 0..D {
+                    let id = if a == c {
+                        2.0 * (st.lam[i] + weight(p, i))
+                    } else {
+                        0.0
+                    };
+                    self.blocks[i][a][c] = id + w * st.off[i * D + a] * st.off[i * D + c];
+                }
+            }
+        }
+        self.newton.factorize(p, &self.blocks)
+    }
+
+    /// The Newton direction for the current `rp` and `rc`, into `dy`, `dr`, `dlam`, `dsig`.
+    fn direction(&mut self) -> Result<()> {
+        let mut step = Step {
+            dy: &mut self.dy,
+            dr: &mut self.dr,
+            dlam: &mut self.dlam,
+            dsig: &mut self.dsig,
+        };
+        direction(
+            self.p,
+            &self.newton,
+            &self.blocks,
+            &self.st,
+            &self.rd,
+            &self.rp,
+            &self.rc,
+            &mut step,
+            &mut self.work,
+        )
+    }
+
+    /// Predictor (affine scaling): complementarity target 0, constraint target 0. Its step
+    /// length and the gap it would reach.
+    fn predictor(&mut self) -> Result<(f64, f64)> {
+        let pinned = self.p.pinned;
+        for i in 0..self.n {
+            self.rc[i] = if pinned[i] {
+                0.0
+            } else {
+                self.st.lam[i] * self.st.sig[i]
+            };
+        }
+        self.rp.fill(0.0);
+        self.direction()?;
+        let st = &self.st;
+        let (dlam, dsig) = (&self.dlam, &self.dsig);
+        let alpha_aff = step_length(&st.lam, dlam, &st.sig, dsig, pinned);
+        let mut gap_aff = 0.0;
+        for i in 0..self.n {
+            if !pinned[i] {
+                gap_aff += (st.lam[i] + alpha_aff * dlam[i]) * (st.sig[i] + alpha_aff * dsig[i]);
+            }
+        }
+        Ok((alpha_aff, gap_aff))
+    }
+
+    /// Corrector: the second-order terms of the predictor, centred at `target`. Two of them:
+    /// `Δλ Δσ` in the complementarity (Mehrotra) and `|Δr|²` in the constraint, which is what
+    /// a point sliding along the band's edge loses to the curvature of the edge (without it
+    /// such a step leaves the band and is cut short).
+    fn corrector(&mut self, alpha_aff: f64, target: f64) -> Result<()> {
+        let pinned = self.p.pinned;
+        let st = &self.st;
+        for i in 0..self.n {
+            if pinned[i] {
+                self.rc[i] = 0.0;
+                self.rp[i] = 0.0;
+                continue;
+            }
+            self.rc[i] = st.lam[i] * st.sig[i] + self.dlam[i] * self.dsig[i] - target;
+            let slide: f64 = (0..D)
+                .map(|a| self.dr[i * D + a] * self.dr[i * D + a])
+                .sum();
+            self.rp[i] = alpha_aff * slide;
+        }
+        self.direction()
+    }
+
+    /// The step along the direction: to the boundary of the linearised slack, shortened until
+    /// every point keeps at least a fraction of its slack (0 when backtracking gives up).
+    fn step_size(&self) -> f64 {
+        let pinned = self.p.pinned;
+        let st = &self.st;
+        let mut alpha = step_length(&st.lam, &self.dlam, &st.sig, &self.dsig, pinned);
+        // The constraints are curved: a point sliding along the band's edge leaves it at
+        // second order. Shorten the step until every point keeps at least a fraction of its
+        // slack (the same rule as the step to the boundary of the linearised slack).
+        let mut tries = 0;
+        while tries < MAX_BACKTRACKS && !inside(st, &self.dr, alpha, pinned) {
+            alpha *= BACKTRACK;
+            tries += 1;
+        }
+        if tries == MAX_BACKTRACKS {
+            alpha = 0.0;
+        }
+        alpha
+    }
+
+    /// Take the step `alpha` along the direction.
+    fn advance(&mut self, alpha: f64) {
+        let pinned = self.p.pinned;
+        let st = &mut self.st;
+        for k in 0..self.dim {
+            st.y[k] += alpha * self.dy[k];
+        }
+        for (o, d) in st.off.iter_mut().zip(&self.dr) {
+            *o += alpha * d;
+        }
+        for i in 0..self.n {
+            if !pinned[i] {
+                st.lam[i] += alpha * self.dlam[i];
+                st.sig[i] += alpha * self.dsig[i];
+            }
+        }
+    }
+
+    /// The solution at the last iterate.
+    fn finish(mut self, iterations: usize, gap: f64, converged: bool) -> Solution {
+        let p = self.p;
+        let pinned = p.pinned;
+        let mut st = self.st;
+        self.ay.fill(0.0);
+        p.energy.apply_add(&st.y, &mut self.ay);
+        // Pinned points sit on their input points by definition; in the spline form the
+        // displacement accumulated over the steps can carry rounding (1e-13 tolerances seen).
+        for (i, _) in pinned.iter().enumerate().filter(|(_, p)| **p) {
+            st.off[i * D..(i + 1) * D].fill(0.0);
+        }
+        let objective = objective(p, &st.y, &self.ay, &st.off);
+        Solution {
+            r: st.off,
+            y: st.y,
+            objective,
+            iterations,
+            gap,
+            converged,
+            multipliers: st.lam,
+        }
+    }
 }
 
 /// A direction: the unknowns' `Δy`, the points' `Δr = B Δy`, and the multipliers' and

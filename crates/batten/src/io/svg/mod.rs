@@ -93,11 +93,44 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Orig
             ),
         ));
     }
+    let node = choose(&doc, root, pick, path)?;
+    if let Some(t) = node
+        .ancestors()
+        .find(|a| a.is_element() && a.attribute("transform").is_some())
+    {
+        return Err(format_err(
+            path,
+            Location::Line(line_of(&doc, t)),
+            format!(
+                "{} has a transform attribute, which batten does not apply; flatten the transform in your editor",
+                describe(&doc, t)
+            ),
+        ));
+    }
+    let origin = Origin {
+        z: 0.0,
+        layer: None,
+        name: node.attribute("id").map(str::to_string),
+    };
+    let raw = match node.tag_name().name() {
+        "path" => from_path(&doc, node, path, pick)?,
+        name => from_points_attribute(&doc, node, path, name == "polygon")?,
+    };
+    Ok((raw, origin))
+}
+
+/// The curve element `pick` names, or the only one there is.
+fn choose<'a, 'input>(
+    doc: &Document<'input>,
+    root: Node<'a, 'input>,
+    pick: &Pick,
+    path: &Path,
+) -> Result<Node<'a, 'input>, IoError> {
     let candidates: Vec<Node<'_, '_>> = root
         .descendants()
         .filter(|n| n.is_element() && CURVE_ELEMENTS.contains(&n.tag_name().name()))
         .collect();
-    let node = match &pick.id {
+    Ok(match &pick.id {
         Some(id) => {
             let Some(n) = root
                 .descendants()
@@ -123,7 +156,7 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Orig
             if !CURVE_ELEMENTS.contains(&n.tag_name().name()) {
                 return Err(format_err(
                     path,
-                    Location::Line(line_of(&doc, n)),
+                    Location::Line(line_of(doc, n)),
                     format!(
                         "element '{id}' is a <{}>, not a <path>, <polyline> or <polygon>",
                         n.tag_name().name()
@@ -142,7 +175,7 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Orig
             }
             [n] => *n,
             many => {
-                let list: Vec<String> = many.iter().map(|n| describe(&doc, *n)).collect();
+                let list: Vec<String> = many.iter().map(|n| describe(doc, *n)).collect();
                 return Err(format_err(
                     path,
                     Location::File,
@@ -154,30 +187,7 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Orig
                 ));
             }
         },
-    };
-    if let Some(t) = node
-        .ancestors()
-        .find(|a| a.is_element() && a.attribute("transform").is_some())
-    {
-        return Err(format_err(
-            path,
-            Location::Line(line_of(&doc, t)),
-            format!(
-                "{} has a transform attribute, which batten does not apply; flatten the transform in your editor",
-                describe(&doc, t)
-            ),
-        ));
-    }
-    let origin = Origin {
-        z: 0.0,
-        layer: None,
-        name: node.attribute("id").map(str::to_string),
-    };
-    let raw = match node.tag_name().name() {
-        "path" => from_path(&doc, node, path, pick)?,
-        name => from_points_attribute(&doc, node, path, name == "polygon")?,
-    };
-    Ok((raw, origin))
+    })
 }
 
 fn line_of(doc: &Document<'_>, n: Node<'_, '_>) -> usize {
@@ -239,46 +249,69 @@ fn from_path(
     }
     let all_lines = sp.segs.iter().all(|s| matches!(s, Seg::Line { .. }));
     if let Some(per) = pick.sample {
-        let per = per.max(1);
-        let mut points = Vec::with_capacity(sp.segs.len() * per + 1);
-        let mut lines = Vec::with_capacity(points.capacity());
-        for s in &sp.segs {
-            let line = pos(s.at()).0;
-            for i in 0..per {
-                // i and per are small counts: exact in f64.
-                points.push(s.eval(i as f64 / per as f64));
-                lines.push(line);
-            }
-        }
-        if !sp.closed
-            && let Some(last) = sp.segs.last()
-        {
-            points.push(last.end());
-            lines.push(pos(last.at()).0);
-        }
-        return Ok(Raw::Points {
-            points,
-            lines,
-            closed: sp.closed,
-        });
+        return Ok(sampled(&sp, per, &pos));
     }
     if all_lines {
-        let mut points = vec![sp.start];
-        let mut lines = vec![pos(sp.at).0];
-        for s in &sp.segs {
-            points.push(s.end());
-            lines.push(pos(s.at()).0);
-        }
-        if sp.closed && points.len() > 1 && points.last() == points.first() {
-            points.pop();
-            lines.pop();
-        }
-        return Ok(Raw::Points {
-            points,
-            lines,
-            closed: sp.closed,
-        });
+        return Ok(corners(sp, &pos));
     }
+    let curve = bezier_spline(&sp).map_err(|e| {
+        format_err(
+            path,
+            Location::Line(line_of(doc, n)),
+            format!("{}: {e}", describe(doc, n)),
+        )
+    })?;
+    Ok(Raw::Curve(curve))
+}
+
+/// `--sample`: `per` points along each segment (and the end of an open path).
+fn sampled(sp: &Subpath, per: usize, pos: &dyn Fn(usize) -> (usize, usize)) -> Raw {
+    let per = per.max(1);
+    let mut points = Vec::with_capacity(sp.segs.len() * per + 1);
+    let mut lines = Vec::with_capacity(points.capacity());
+    for s in &sp.segs {
+        let line = pos(s.at()).0;
+        for i in 0..per {
+            // i and per are small counts: exact in f64.
+            points.push(s.eval(i as f64 / per as f64));
+            lines.push(line);
+        }
+    }
+    if !sp.closed
+        && let Some(last) = sp.segs.last()
+    {
+        points.push(last.end());
+        lines.push(pos(last.at()).0);
+    }
+    Raw::Points {
+        points,
+        lines,
+        closed: sp.closed,
+    }
+}
+
+/// A path of lines: its corner points (a closed path's repeated start left out).
+fn corners(sp: Subpath, pos: &dyn Fn(usize) -> (usize, usize)) -> Raw {
+    let mut points = vec![sp.start];
+    let mut lines = vec![pos(sp.at).0];
+    for s in &sp.segs {
+        points.push(s.end());
+        lines.push(pos(s.at()).0);
+    }
+    if sp.closed && points.len() > 1 && points.last() == points.first() {
+        points.pop();
+        lines.pop();
+    }
+    Raw::Points {
+        points,
+        lines,
+        closed: sp.closed,
+    }
+}
+
+/// A path with curves: the cubic B-spline of its segments as Béziers (integer knots, each
+/// interior one triple).
+fn bezier_spline(sp: &Subpath) -> crate::Result<BSplineCurve> {
     let m = sp.segs.len();
     let mut ctrl = Vec::with_capacity(3 * m + 1);
     ctrl.push(sp.start);
@@ -292,16 +325,7 @@ fn from_path(
         knots.extend([i as f64; 3]);
     }
     knots.extend([m as f64; 4]);
-    let curve = KnotVector::try_new(knots)
-        .and_then(|k| BSplineCurve::try_new(3, k, ctrl, None))
-        .map_err(|e| {
-            format_err(
-                path,
-                Location::Line(line_of(doc, n)),
-                format!("{}: {e}", describe(doc, n)),
-            )
-        })?;
-    Ok(Raw::Curve(curve))
+    KnotVector::try_new(knots).and_then(|k| BSplineCurve::try_new(3, k, ctrl, None))
 }
 
 /// The `points` of a `<polyline>` or `<polygon>`.

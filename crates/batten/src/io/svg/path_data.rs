@@ -197,34 +197,76 @@ impl Lexer<'_> {
 /// A [`PathError`] at the offending byte: an unknown command, a missing or malformed
 /// number, data that does not start with `M`, an arc.
 pub(crate) fn parse(d: &str) -> Result<Vec<Subpath>, PathError> {
-    let mut lx = Lexer {
-        s: d.as_bytes(),
-        i: 0,
+    let mut pp = PathParser {
+        d,
+        lx: Lexer {
+            s: d.as_bytes(),
+            i: 0,
+        },
+        subpaths: Vec::new(),
+        cur: Point::new(0.0, 0.0),
+        last_cubic_ctrl: None,
+        last_quad_ctrl: None,
+        cmd: None,
     };
-    let mut subpaths: Vec<Subpath> = Vec::new();
-    let mut cur = Point::new(0.0, 0.0);
-    // The reflected control point for S (cubic) and T (quadratic).
-    let mut last_cubic_ctrl: Option<Point> = None;
-    let mut last_quad_ctrl: Option<Point> = None;
-    let mut cmd: Option<u8> = None;
     loop {
-        lx.skip_ws();
-        if lx.i >= lx.s.len() {
+        pp.lx.skip_ws();
+        if pp.lx.i >= pp.lx.s.len() {
             break;
         }
-        let at = lx.i;
-        let c = lx.s[at];
-        let command = if c.is_ascii_alphabetic() {
-            lx.i += 1;
+        let at = pp.lx.i;
+        let command = pp.command(at)?;
+        if pp.subpaths.is_empty() && !matches!(command, b'M' | b'm') {
+            return err(at, "path data must start with M (moveto)");
+        }
+        let seg = pp.segment(command, at)?;
+        pp.last_cubic_ctrl = None;
+        pp.last_quad_ctrl = None;
+        if let Some(s) = seg {
+            pp.push(s, at);
+        }
+        pp.cmd = Some(command);
+        // Arguments may repeat: keep the command for a following number.
+        if matches!(command, b'Z' | b'z') {
+            pp.lx.skip_ws();
+            if pp.lx.number_follows() {
+                return err(pp.lx.i, "closepath (Z) takes no numbers");
+            }
+        }
+    }
+    if pp.subpaths.is_empty() {
+        return err(0, "empty path data");
+    }
+    Ok(pp.subpaths)
+}
+
+/// The state of [`parse`] between commands.
+struct PathParser<'a> {
+    d: &'a str,
+    lx: Lexer<'a>,
+    subpaths: Vec<Subpath>,
+    cur: Point,
+    /// The reflected control point for S (cubic) and T (quadratic).
+    last_cubic_ctrl: Option<Point>,
+    last_quad_ctrl: Option<Point>,
+    cmd: Option<u8>,
+}
+
+impl PathParser<'_> {
+    /// The command at `at`: its letter, or the previous command repeated before a number.
+    fn command(&mut self, at: usize) -> Result<u8, PathError> {
+        let c = self.lx.s[at];
+        Ok(if c.is_ascii_alphabetic() {
+            self.lx.i += 1;
             c
         } else {
-            match cmd {
+            match self.cmd {
                 // Repeated arguments: M becomes L, Z takes none.
                 Some(b'M') => b'L',
                 Some(b'm') => b'l',
                 Some(b'Z' | b'z') | None => {
-                    let c =
-                        char::from_u32(d[at..].chars().next().map_or(0, u32::from)).unwrap_or('?');
+                    let c = char::from_u32(self.d[at..].chars().next().map_or(0, u32::from))
+                        .unwrap_or('?');
                     return err(
                         at,
                         format!("expected a command letter, found '{}'", c.escape_debug()),
@@ -232,10 +274,14 @@ pub(crate) fn parse(d: &str) -> Result<Vec<Subpath>, PathError> {
                 }
                 Some(k) => k,
             }
-        };
-        if subpaths.is_empty() && !matches!(command, b'M' | b'm') {
-            return err(at, "path data must start with M (moveto)");
-        }
+        })
+    }
+
+    /// Read the arguments of `command` (at `at`): the segment it draws, if any (M and Z
+    /// change the subpaths themselves).
+    fn segment(&mut self, command: u8, at: usize) -> Result<Option<Seg>, PathError> {
+        let cur = self.cur;
+        let lx = &mut self.lx;
         let rel = command.is_ascii_lowercase();
         // Relative coordinates are offsets from the current point; absolute ones are taken
         // as written (not added to the origin, which would turn −0 into +0).
@@ -245,8 +291,8 @@ pub(crate) fn parse(d: &str) -> Result<Vec<Subpath>, PathError> {
         match command.to_ascii_uppercase() {
             b'M' => {
                 let p = off(base(cur), lx.pair("moveto x, y")?);
-                cur = p;
-                subpaths.push(Subpath {
+                self.cur = p;
+                self.subpaths.push(Subpath {
                     start: p,
                     at,
                     segs: Vec::new(),
@@ -279,7 +325,8 @@ pub(crate) fn parse(d: &str) -> Result<Vec<Subpath>, PathError> {
             }
             b'S' => {
                 let b = base(cur);
-                let c1 = last_cubic_ctrl
+                let c1 = self
+                    .last_cubic_ctrl
                     .map_or(cur, |q| Point::new(2.0 * cur.x - q.x, 2.0 * cur.y - q.y));
                 let c2 = off(b, lx.pair("smooth curveto x2, y2")?);
                 let p = off(b, lx.pair("smooth curveto x, y")?);
@@ -298,7 +345,8 @@ pub(crate) fn parse(d: &str) -> Result<Vec<Subpath>, PathError> {
                 });
             }
             b'T' => {
-                let c1 = last_quad_ctrl
+                let c1 = self
+                    .last_quad_ctrl
                     .map_or(cur, |q| Point::new(2.0 * cur.x - q.x, 2.0 * cur.y - q.y));
                 let p = off(base(cur), lx.pair("smooth quadratic curveto x, y")?);
                 seg = Some(Seg::Quad {
@@ -306,19 +354,7 @@ pub(crate) fn parse(d: &str) -> Result<Vec<Subpath>, PathError> {
                     at,
                 });
             }
-            b'Z' => {
-                // `if let` on the last subpath: one exists (checked above).
-                if let Some(sp) = subpaths.last_mut() {
-                    if cur != sp.start {
-                        sp.segs.push(Seg::Line {
-                            p: [cur, sp.start],
-                            at,
-                        });
-                    }
-                    sp.closed = true;
-                    cur = sp.start;
-                }
-            }
+            b'Z' => self.close(at),
             b'A' => {
                 return err(
                     at,
@@ -335,43 +371,50 @@ pub(crate) fn parse(d: &str) -> Result<Vec<Subpath>, PathError> {
                 );
             }
         }
-        last_cubic_ctrl = None;
-        last_quad_ctrl = None;
-        if let Some(s) = seg {
-            match s {
-                Seg::Cubic { p, .. } => last_cubic_ctrl = Some(p[2]),
-                Seg::Quad { p, .. } => last_quad_ctrl = Some(p[1]),
-                Seg::Line { .. } => {}
+        Ok(seg)
+    }
+
+    /// Z: close the current subpath (with a line back to its start when not there) and move
+    /// to its start.
+    fn close(&mut self, at: usize) {
+        let cur = self.cur;
+        // `if let` on the last subpath: one exists (checked above).
+        if let Some(sp) = self.subpaths.last_mut() {
+            if cur != sp.start {
+                sp.segs.push(Seg::Line {
+                    p: [cur, sp.start],
+                    at,
+                });
             }
-            cur = s.end();
-            if let Some(sp) = subpaths.last_mut() {
-                if sp.closed {
-                    // Drawing on after Z starts a new subpath at the same start point.
-                    let start = sp.start;
-                    subpaths.push(Subpath {
-                        start,
-                        at,
-                        segs: vec![s],
-                        closed: false,
-                    });
-                } else {
-                    sp.segs.push(s);
-                }
-            }
+            sp.closed = true;
+            self.cur = sp.start;
         }
-        cmd = Some(command);
-        // Arguments may repeat: keep the command for a following number.
-        if matches!(command, b'Z' | b'z') {
-            lx.skip_ws();
-            if lx.number_follows() {
-                return err(lx.i, "closepath (Z) takes no numbers");
+    }
+
+    /// Add a drawn segment to the current subpath (or to a new one after Z) and move on to
+    /// its end.
+    fn push(&mut self, s: Seg, at: usize) {
+        match s {
+            Seg::Cubic { p, .. } => self.last_cubic_ctrl = Some(p[2]),
+            Seg::Quad { p, .. } => self.last_quad_ctrl = Some(p[1]),
+            Seg::Line { .. } => {}
+        }
+        self.cur = s.end();
+        if let Some(sp) = self.subpaths.last_mut() {
+            if sp.closed {
+                // Drawing on after Z starts a new subpath at the same start point.
+                let start = sp.start;
+                self.subpaths.push(Subpath {
+                    start,
+                    at,
+                    segs: vec![s],
+                    closed: false,
+                });
+            } else {
+                sp.segs.push(s);
             }
         }
     }
-    if subpaths.is_empty() {
-        return err(0, "empty path data");
-    }
-    Ok(subpaths)
 }
 
 #[cfg(test)]

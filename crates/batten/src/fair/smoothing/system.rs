@@ -1,4 +1,4 @@
-//! The pentadiagonal system of the open smoothing spline (see [`super::smoothing`]), solved
+//! The pentadiagonal system of the open smoothing spline (see [`super`]), solved
 //! without the general band code: the matrix as three diagonals, its `L D Lᵀ` factorisation
 //! and the solve for every coordinate at once, written out for half-bandwidth 2.
 //!

@@ -1,19 +1,19 @@
 //! The `mst` fairing method: the glue between the fairing contract and the smoothing spline
-//! of [`super::smoothing`] (its parameters, the choice of p, the report), for planar points
+//! of [`super`] (its parameters, the choice of p, the report), for planar points
 //! and, coordinate by coordinate with shared chord-length parameters and one p, for space
 //! curves ([`crate::fair::fair_space`]).
 
 use serde_json::{Map, Value};
 
-use super::smoothing::{
-    DEFAULT_MAX_BISECTION_STEPS, Smoothing, check_p, param_p, roughness, select_any,
-};
-use super::{FairMethod, FairOptions, FairStatus, HistoryRow, Outcome, ParamSpec, SpaceOutcome};
+use super::{DEFAULT_MAX_BISECTION_STEPS, Smoothing, check_p, param_p, roughness, select_any};
 use crate::error::Result;
+use crate::fair::{
+    FairMethod, FairOptions, FairStatus, HistoryRow, Outcome, ParamSpec, SpaceOutcome,
+};
 use crate::geom::{Point, PointSeq, SpaceSeq, Xyz};
 use crate::spline::{Parametrization, parameters};
 
-use super::params::{Auto, Param};
+use crate::fair::params::{Auto, Param};
 
 /// The smoothing parameter p (`auto`: chosen for the tolerance, or by GCV).
 pub(crate) const P: Param<Auto<f64>> = Param {
@@ -29,13 +29,13 @@ static PARAMS: &[ParamSpec] = &[P.spec()];
 /// The `mst` fairing method: the cubic smoothing spline of the points at chord-length
 /// parameters, with p given (`--set p=…`), chosen for `--tolerance`, or by GCV. See
 /// [`super::SmoothingSpline`] for the library API (the equations are in the source,
-/// `fair/smoothing.rs`).
+/// `fair/smoothing/`).
 ///
 /// Reports `p`, `alpha`, `selection` (`given`, `tolerance`, `gcv`), `roughness` and, for GCV,
 /// `gcv` and `degrees_of_freedom` in [`Outcome::parameters`]; iterations are the splines the
 /// search computed (bisection steps or GCV evaluations). [`Outcome::curve`] is left empty: the
 /// method's product is the points, and building the curve would triple its cost at 10⁶
-/// points; the library's [`SmoothingSpline::curve`] gives the spline itself
+/// points; the library's [`SmoothingSpline::curve`](super::SmoothingSpline::curve) gives the spline itself
 /// (`BSplineCurve::from_parametric_cubic` turns it into exact B-spline form).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Mst;
@@ -128,7 +128,7 @@ fn chord_parameters(points: &[Xyz], closed: bool) -> Vec<f64> {
     let spans = if closed { n } else { n - 1 };
     let mut t = vec![0.0; spans + 1];
     for i in 0..spans {
-        t[i + 1] = t[i] + super::space::distance(&points[(i + 1) % n], &points[i]);
+        t[i + 1] = t[i] + crate::fair::space::distance(&points[(i + 1) % n], &points[i]);
     }
     t
 }

@@ -246,6 +246,22 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Orig
     let gdata: Vec<u8> = g.iter().flat_map(|r| r.text[..DATA].to_vec()).collect();
     let (pd, rd) =
         delimiters(&gdata).map_err(|m| err(path, g[0].line, format!("global section: {m}")))?;
+    let dirs = directory(&d, path)?;
+    let e = choose(&dirs, pick, path)?;
+    let params = Params::of(e, &p, pd, rd, path)?;
+    let origin = Origin {
+        z: 0.0,
+        layer: Some(e.level.to_string()),
+        name: Some(e.de.to_string()),
+    };
+    if e.kind == 106 {
+        return copious_data(e, &params, origin);
+    }
+    b_spline(&params, origin)
+}
+
+/// The directory entries, two D records each.
+fn directory(d: &[Rec], path: &Path) -> Result<Vec<Dir>, IoError> {
     if d.len() % 2 == 1 {
         return Err(err(
             path,
@@ -281,25 +297,37 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Orig
             form: geti(b, 14)?,
         });
     }
-    let is_curve = |e: &Dir| {
-        let sub = e.status.get(2..4).unwrap_or("00");
-        let independent = matches!(sub, "00" | "02" | "" | "0");
-        independent && (e.kind == 126 || (e.kind == 106 && matches!(e.form, 1 | 2 | 11 | 12 | 63)))
-    };
-    let describe = |e: &Dir| {
-        format!(
-            "entity {} form {} at DE {} (level {})",
-            e.kind, e.form, e.de, e.level
-        )
-    };
+    Ok(dirs)
+}
+
+/// Whether a directory entry is a curve batten reads: an independent entity 126, or 106 of
+/// a form that holds a curve.
+fn is_curve(e: &Dir) -> bool {
+    let sub = e.status.get(2..4).unwrap_or("00");
+    let independent = matches!(sub, "00" | "02" | "" | "0");
+    independent && (e.kind == 126 || (e.kind == 106 && matches!(e.form, 1 | 2 | 11 | 12 | 63)))
+}
+
+/// A directory entry as messages name it.
+fn describe(e: &Dir) -> String {
+    format!(
+        "entity {} form {} at DE {} (level {})",
+        e.kind, e.form, e.de, e.level
+    )
+}
+
+/// Directory entries as messages list them.
+fn list(v: &[&Dir]) -> String {
+    if v.is_empty() {
+        "none".to_string()
+    } else {
+        v.iter().map(|e| describe(e)).collect::<Vec<_>>().join(", ")
+    }
+}
+
+/// The one curve entity `pick` leaves, or why there is none.
+fn choose<'d>(dirs: &'d [Dir], pick: &Pick, path: &Path) -> Result<&'d Dir, IoError> {
     let all: Vec<&Dir> = dirs.iter().filter(|e| is_curve(e)).collect();
-    let list = |v: &[&Dir]| {
-        if v.is_empty() {
-            "none".to_string()
-        } else {
-            v.iter().map(|e| describe(e)).collect::<Vec<_>>().join(", ")
-        }
-    };
     let mut chosen = all.clone();
     if let Some(de) = &pick.entity {
         let want = de
@@ -333,147 +361,181 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, pick: &Pick) -> Result<(Raw, Orig
             ));
         }
     }
-    let e = match chosen.as_slice() {
-        [] => {
+    match chosen.as_slice() {
+        [] => Err(err(
+            path,
+            0,
+            "no entity 126 (B-spline curve) or 106 (copious data, forms 1, 2, 11, 12, 63)",
+        )),
+        [e] => Ok(*e),
+        many => Err(err(
+            path,
+            0,
+            format!(
+                "{} curve entities, pick one with --entity DE or --layer LEVEL: {}",
+                many.len(),
+                list(many)
+            ),
+        )),
+    }
+}
+
+/// The parameter data of the chosen entity, as tokens, with what names it in messages.
+struct Params<'a> {
+    toks: Vec<String>,
+    /// The entity as [`describe`] names it.
+    what: String,
+    /// The line of its first P record.
+    pline: usize,
+    path: &'a Path,
+}
+
+impl<'a> Params<'a> {
+    /// The entity's parameter data, checked to be where the directory says and to start
+    /// with the entity's type.
+    fn of(e: &Dir, p: &[Rec], pd: u8, rd: u8, path: &'a Path) -> Result<Params<'a>, IoError> {
+        let what = describe(e);
+        if e.matrix != 0 {
             return Err(err(
                 path,
-                0,
-                "no entity 126 (B-spline curve) or 106 (copious data, forms 1, 2, 11, 12, 63)",
-            ));
-        }
-        [e] => *e,
-        many => {
-            return Err(err(
-                path,
-                0,
+                e.line,
                 format!(
-                    "{} curve entities, pick one with --entity DE or --layer LEVEL: {}",
-                    many.len(),
-                    list(many)
+                    "{what} has a transformation matrix (DE {}), which batten does not apply",
+                    e.matrix
                 ),
             ));
         }
-    };
-    let what = describe(e);
-    if e.matrix != 0 {
-        return Err(err(
+        if e.param == 0 || e.param > p.len() || e.param - 1 + e.param_count.max(1) > p.len() {
+            return Err(err(
+                path,
+                e.line,
+                format!(
+                    "{what}: its parameter data pointer {} (with {} records) is outside the P section of {} records",
+                    e.param,
+                    e.param_count,
+                    p.len()
+                ),
+            ));
+        }
+        let recs = &p[e.param - 1..e.param - 1 + e.param_count.max(1)];
+        let data: Vec<u8> = recs
+            .iter()
+            .flat_map(|r| r.text[..P_DATA].to_vec())
+            .collect();
+        let pline = recs[0].line;
+        let toks = tokens(&data, pd, rd).map_err(|m| err(path, pline, format!("{what}: {m}")))?;
+        let params = Params {
+            toks,
+            what,
+            pline,
             path,
-            e.line,
-            format!(
-                "{what} has a transformation matrix (DE {}), which batten does not apply",
-                e.matrix
-            ),
-        ));
-    }
-    if e.param == 0 || e.param > p.len() || e.param - 1 + e.param_count.max(1) > p.len() {
-        return Err(err(
-            path,
-            e.line,
-            format!(
-                "{what}: its parameter data pointer {} (with {} records) is outside the P section of {} records",
-                e.param,
-                e.param_count,
-                p.len()
-            ),
-        ));
-    }
-    let recs = &p[e.param - 1..e.param - 1 + e.param_count.max(1)];
-    let data: Vec<u8> = recs
-        .iter()
-        .flat_map(|r| r.text[..P_DATA].to_vec())
-        .collect();
-    let pline = recs[0].line;
-    let toks = tokens(&data, pd, rd).map_err(|m| err(path, pline, format!("{what}: {m}")))?;
-    let fail = |m: String| err(path, pline, format!("{what}: {m}"));
-    let ti = |i: usize| -> Result<i64, IoError> {
-        let t = toks
-            .get(i)
-            .ok_or_else(|| fail(format!("{} parameters, more expected", toks.len())))?;
-        int(t).ok_or_else(|| fail(format!("parameter {i} '{t}' is not an integer")))
-    };
-    let tr = |i: usize| -> Result<f64, IoError> {
-        let t = toks
-            .get(i)
-            .ok_or_else(|| fail(format!("{} parameters, more expected", toks.len())))?;
-        real(t).ok_or_else(|| fail(format!("parameter {i} '{t}' is not a finite real")))
-    };
-    if ti(0)? != e.kind {
-        return Err(fail(format!(
-            "its parameter data starts with entity type '{}'",
-            toks.first().map_or("", String::as_str)
-        )));
-    }
-    let origin = Origin {
-        z: 0.0,
-        layer: Some(e.level.to_string()),
-        name: Some(e.de.to_string()),
-    };
-    // The constant z, or the first two values that differ.
-    let planar = |zs: &[f64]| -> Result<f64, (f64, f64)> {
-        match zs.iter().find(|&&z| z != zs[0]) {
-            Some(&z) => Err((zs[0], z)),
-            None => Ok(zs.first().copied().unwrap_or(0.0)),
-        }
-    };
-    if e.kind == 106 {
-        let ip = ti(1)?;
-        let n = usize::try_from(ti(2)?).map_err(|_| fail("negative point count".into()))?;
-        let (first, stride, zs) = match ip {
-            1 => (4, 2, None),
-            2 => (3, 3, Some(2)),
-            3 => (3, 6, Some(2)),
-            _ => {
-                return Err(fail(format!(
-                    "interpretation flag {ip}, expected 1, 2 or 3"
-                )));
-            }
         };
-        let mut points = Vec::with_capacity(n);
-        let mut z = Vec::with_capacity(n);
-        for i in 0..n {
-            let b = first + stride * i;
-            points.push(Point::new(tr(b)?, tr(b + 1)?));
-            z.push(match zs {
-                Some(o) => tr(b + o)?,
-                None => tr(3)?,
-            });
+        if params.int(0)? != e.kind {
+            return Err(params.fail(format!(
+                "its parameter data starts with entity type '{}'",
+                params.toks.first().map_or("", String::as_str)
+            )));
         }
-        let z = match planar(&z) {
-            Ok(z) => z,
-            Err(_) => {
-                let mut points: Vec<[f64; 3]> =
-                    points.iter().zip(&z).map(|(p, z)| [p.x, p.y, *z]).collect();
-                // A copious-data curve that returns to its start is closed.
-                let closed = points.len() > 1 && points.last() == points.first();
-                if closed {
-                    points.pop();
-                }
-                let lines = vec![pline; points.len()];
-                return Ok((
-                    Raw::Space {
-                        points,
-                        lines,
-                        closed,
-                    },
-                    origin,
-                ));
-            }
-        };
-        let closed = e.form == 63;
-        if closed && points.len() > 1 && points.last() == points.first() {
-            points.pop();
-        }
-        let lines = vec![pline; points.len()];
-        return Ok((
-            Raw::Points {
-                points,
-                lines,
-                closed,
-            },
-            Origin { z, ..origin },
-        ));
+        Ok(params)
     }
-    // Entity 126.
+
+    /// An error about the entity's parameter data.
+    fn fail(&self, m: String) -> IoError {
+        err(self.path, self.pline, format!("{}: {m}", self.what))
+    }
+
+    /// Parameter `i` as an integer.
+    fn int(&self, i: usize) -> Result<i64, IoError> {
+        let t = self
+            .toks
+            .get(i)
+            .ok_or_else(|| self.fail(format!("{} parameters, more expected", self.toks.len())))?;
+        int(t).ok_or_else(|| self.fail(format!("parameter {i} '{t}' is not an integer")))
+    }
+
+    /// Parameter `i` as a finite real.
+    fn real(&self, i: usize) -> Result<f64, IoError> {
+        let t = self
+            .toks
+            .get(i)
+            .ok_or_else(|| self.fail(format!("{} parameters, more expected", self.toks.len())))?;
+        real(t).ok_or_else(|| self.fail(format!("parameter {i} '{t}' is not a finite real")))
+    }
+}
+
+/// The constant z, or the first two values that differ.
+fn planar(zs: &[f64]) -> Result<f64, (f64, f64)> {
+    match zs.iter().find(|&&z| z != zs[0]) {
+        Some(&z) => Err((zs[0], z)),
+        None => Ok(zs.first().copied().unwrap_or(0.0)),
+    }
+}
+
+/// Entity 106: planar points, or space points when z varies.
+fn copious_data(e: &Dir, params: &Params<'_>, origin: Origin) -> Result<(Raw, Origin), IoError> {
+    let (ti, tr) = (|i| params.int(i), |i| params.real(i));
+    let pline = params.pline;
+    let ip = ti(1)?;
+    let n = usize::try_from(ti(2)?).map_err(|_| params.fail("negative point count".into()))?;
+    let (first, stride, zs) = match ip {
+        1 => (4, 2, None),
+        2 => (3, 3, Some(2)),
+        3 => (3, 6, Some(2)),
+        _ => {
+            return Err(params.fail(format!("interpretation flag {ip}, expected 1, 2 or 3")));
+        }
+    };
+    let mut points = Vec::with_capacity(n);
+    let mut z = Vec::with_capacity(n);
+    for i in 0..n {
+        let b = first + stride * i;
+        points.push(Point::new(tr(b)?, tr(b + 1)?));
+        z.push(match zs {
+            Some(o) => tr(b + o)?,
+            None => tr(3)?,
+        });
+    }
+    let z = match planar(&z) {
+        Ok(z) => z,
+        Err(_) => {
+            let mut points: Vec<[f64; 3]> =
+                points.iter().zip(&z).map(|(p, z)| [p.x, p.y, *z]).collect();
+            // A copious-data curve that returns to its start is closed.
+            let closed = points.len() > 1 && points.last() == points.first();
+            if closed {
+                points.pop();
+            }
+            let lines = vec![pline; points.len()];
+            return Ok((
+                Raw::Space {
+                    points,
+                    lines,
+                    closed,
+                },
+                origin,
+            ));
+        }
+    };
+    let closed = e.form == 63;
+    if closed && points.len() > 1 && points.last() == points.first() {
+        points.pop();
+    }
+    let lines = vec![pline; points.len()];
+    Ok((
+        Raw::Points {
+            points,
+            lines,
+            closed,
+        },
+        Origin { z, ..origin },
+    ))
+}
+
+/// Entity 126: a planar, untrimmed B-spline.
+fn b_spline(params: &Params<'_>, origin: Origin) -> Result<(Raw, Origin), IoError> {
+    let (ti, tr) = (|i| params.int(i), |i| params.real(i));
+    let fail = |m: String| params.fail(m);
+    let toks = &params.toks;
     let k = usize::try_from(ti(1)?).map_err(|_| fail("negative K".into()))?;
     let m = usize::try_from(ti(2)?).map_err(|_| fail("negative degree M".into()))?;
     let polynomial = ti(5)? == 1;
@@ -729,200 +791,4 @@ pub(crate) fn format_curve(curve: &BSplineCurve, closed: bool, origin: &Origin) 
 
 #[cfg(test)]
 #[allow(clippy::unwrap_used)]
-mod tests {
-    use super::*;
-
-    fn read(text: &str, pick: &Pick) -> Result<(Raw, Origin), String> {
-        parse(text.as_bytes(), Path::new("c.igs"), pick).map_err(|e| e.to_string())
-    }
-
-    fn curve() -> BSplineCurve {
-        let knots =
-            KnotVector::try_new(vec![0., 0., 0., 0., 0.3, 1.0 / 3.0, 1., 1., 1., 1.]).unwrap();
-        let ctrl = vec![
-            Point::new(0.1, -1.0 / 3.0),
-            Point::new(1e-300, 2.5),
-            Point::new(3.0, 1e5 / 7.0),
-            Point::new(-4.0, 0.0),
-            Point::new(5.0, -2.0),
-            Point::new(6.0, f64::MAX / 3.0),
-        ];
-        BSplineCurve::try_new(3, knots, ctrl, Some(vec![1.0, 0.5, 2.0, 1.0, 1.0, 0.75])).unwrap()
-    }
-
-    #[test]
-    fn reals_are_exact_with_a_point_and_d_exponent() {
-        assert_eq!(real_str(0.1), "1.0D-1");
-        assert_eq!(real_str(-2500.0), "-2.5D3");
-        assert_eq!(real_str(0.0), "0.0D0");
-        for x in [
-            0.1,
-            -1.0 / 3.0,
-            1e-300,
-            5e-324,
-            f64::MAX,
-            -0.0,
-            123456789.125,
-        ] {
-            assert_eq!(real(&real_str(x)).unwrap().to_bits(), x.to_bits(), "{x}");
-        }
-        assert_eq!(real("1."), Some(1.0));
-        assert_eq!(real(".5E1"), Some(5.0));
-        assert_eq!(real("2d2"), Some(200.0));
-    }
-
-    #[test]
-    fn records_are_80_columns_and_the_curve_reads_back_bit_for_bit() {
-        let c = curve();
-        let origin = Origin {
-            z: 7.5,
-            layer: Some("3".into()),
-            name: None,
-        };
-        let text = format_curve(&c, false, &origin);
-        assert!(text.lines().all(|l| l.len() == 80), "{text}");
-        let (raw, o) = read(&text, &Pick::default()).unwrap();
-        let Raw::Curve(back) = raw else { panic!() };
-        assert_eq!(back, c);
-        assert_eq!(o.z, 7.5);
-        assert_eq!(o.layer.as_deref(), Some("3"));
-        assert_eq!(o.name.as_deref(), Some("1"));
-        // Polynomial: no weights.
-        let plain =
-            BSplineCurve::try_new(3, c.knots().clone(), c.control_points().to_vec(), None).unwrap();
-        let (raw, _) = read(
-            &format_curve(&plain, false, &Origin::default()),
-            &Pick::default(),
-        )
-        .unwrap();
-        assert_eq!(raw_curve(raw), plain);
-    }
-
-    fn raw_curve(r: Raw) -> BSplineCurve {
-        match r {
-            Raw::Curve(c) => c,
-            _ => panic!("not a curve"),
-        }
-    }
-
-    #[test]
-    fn copious_data_round_trip_open_and_closed() {
-        let pts: Vec<Point> = (0..40)
-            .map(|i| Point::new(f64::from(i) / 7.0, (f64::from(i) * 0.3).sin()))
-            .collect();
-        for closed in [false, true] {
-            let text = format_points(
-                &pts,
-                closed,
-                &Origin {
-                    z: -1.0,
-                    ..Origin::default()
-                },
-            );
-            let (raw, o) = read(&text, &Pick::default()).unwrap();
-            let Raw::Points {
-                points, closed: c, ..
-            } = raw
-            else {
-                panic!()
-            };
-            assert_eq!(points, pts);
-            assert_eq!(c, closed);
-            assert_eq!(o.z, -1.0);
-        }
-    }
-
-    /// A file in the style of other writers: delimiters defaulted, reals as `1.`, `E`
-    /// exponents, two entities, a 3-D polyline.
-    const TWO: &str = "\
-Hand-made test file                                                     S      1
-,,4Htest,5Hx.igs,4Htest,3H1.0,32,38,6,308,15,4Htest,1.,2,2HMM,1,1.,     G      1
-15H20240101.000000,1.E-08,10.,,,11,0,15H20240101.000000;                G      2
-     106       1       0       0       0       0       0       000000000D      1
-     106       0       0       1      11                               0D      2
-     106       2       0       0       5       0       0       000000000D      3
-     106       0       0       2      12                               0D      4
-106,1,4,0.,0.,0.,1.,0.,1.,1.,2.,1.5E0;                                 1P      1
-106,2,4,0.,0.,0.,1.,0.,0.,1.,1.,1.,2.,1.5,                             3P      2
-2.;                                                                    3P      3
-S      1G      2D      4P      3                                        T      1
-";
-
-    #[test]
-    fn other_writers_style_picking_and_3d_copious_data() {
-        let e = read(TWO, &Pick::default()).unwrap_err();
-        assert_eq!(
-            e,
-            "c.igs: 2 curve entities, pick one with --entity DE or --layer LEVEL: entity 106 form 11 at DE 1 (level 0), entity 106 form 12 at DE 3 (level 5)"
-        );
-        let (raw, o) = read(TWO, &Pick::default().with_entity(Some("1".into()))).unwrap();
-        let Raw::Points { points, lines, .. } = raw else {
-            panic!()
-        };
-        assert_eq!(points[3], Point::new(2.0, 1.5));
-        assert_eq!(lines, vec![8; 4]);
-        assert_eq!(o.z, 0.0);
-        // Its z varies: a space curve.
-        let (raw, _) = read(TWO, &Pick::default().with_layer(Some("5".into()))).unwrap();
-        let Raw::Space { points, closed, .. } = raw else {
-            panic!("not a space curve")
-        };
-        assert!(!closed);
-        assert_eq!(points[1], [1.0, 0.0, 0.0]);
-        assert_eq!(points[3], [2.0, 1.5, 2.0]);
-        let e = read(TWO, &Pick::default().with_entity(Some("7".into()))).unwrap_err();
-        assert!(
-            e.starts_with(
-                "c.igs: no curve entity at directory entry 7 (curve entities: entity 106"
-            ),
-            "{e}"
-        );
-    }
-
-    #[test]
-    fn malformed_files_name_the_line() {
-        let e = read("hello\n", &Pick::default()).unwrap_err();
-        assert_eq!(
-            e,
-            "c.igs:1: record too short for a section letter in column 73 (not a fixed-form IGES file?)"
-        );
-        let bad = TWO.replace(
-            "106,1,4,0.,0.,0.,1.,0.,1.,1.,2.,1.5E0;",
-            "106,1,4,0.,0.,0.,1.,0.,1.,1.,2.,x.5E0;",
-        );
-        let e = read(&bad, &Pick::default().with_entity(Some("1".into()))).unwrap_err();
-        assert_eq!(
-            e,
-            "c.igs:8: entity 106 form 11 at DE 1 (level 0): parameter 11 'x.5E0' is not a finite real"
-        );
-        let bad = TWO.replace(
-            "106,1,4,0.,0.,0.,1.,0.,1.,1.,2.,1.5E0;",
-            "106,1,5,0.,0.,0.,1.,0.,1.,1.,2.,1.5E0;",
-        );
-        let e = read(&bad, &Pick::default().with_entity(Some("1".into()))).unwrap_err();
-        assert_eq!(
-            e,
-            "c.igs:8: entity 106 form 11 at DE 1 (level 0): 12 parameters, more expected"
-        );
-        let bad = TWO.replace(
-            "     106       1       0       0       0       0       0       000000000D      1",
-            "     106      99       0       0       0       0       0       000000000D      1",
-        );
-        let e = read(&bad, &Pick::default().with_entity(Some("1".into()))).unwrap_err();
-        assert!(
-            e.starts_with(
-                "c.igs:4: entity 106 form 11 at DE 1 (level 0): its parameter data pointer 99"
-            ),
-            "{e}"
-        );
-        let e = read(
-            &TWO.replace(
-                ";                                 1P",
-                ",                                 1P",
-            ),
-            &Pick::default().with_entity(Some("1".into())),
-        )
-        .unwrap_err();
-        assert!(e.ends_with("the record delimiter is missing"), "{e}");
-    }
-}
+mod tests;

@@ -1,4 +1,4 @@
-//! What every trial of the smoothing spline's searches measures (see [`super::smoothing`]):
+//! What every trial of the smoothing spline's searches measures (see [`super`]):
 //! the largest displacement of the points, which decides the tolerance search, and the
 //! roughness, which the report's history prints. Both as the fairing report measures them,
 //! bit for bit, and both cheap, since the search measures about 19 trials (issue #17).
