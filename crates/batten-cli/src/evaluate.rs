@@ -1,6 +1,6 @@
-//! `batten evaluate`: the fairness evaluation of Kuragano & Yamaguchi (spec §5.6) of the
-//! curve through the points (their uniform quintic interpolant) or of a B-spline JSON file,
-//! printed like the paper's Tables 3 and 4, or as JSON.
+//! `batten evaluate`: the fairness evaluation of Kuragano & Yamaguchi (docs/algorithms/kuragano.md
+//! §5.6) of the curve through the points (their uniform quintic interpolant) or of a B-spline JSON
+//! file, printed like the paper's Tables 3 and 4, or as JSON.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;

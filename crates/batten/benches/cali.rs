@@ -1,6 +1,6 @@
-//! The `cali` method (Calì et al., spec §4.5) on noisy curves of n = 10², 10³, 10⁴ points, its
-//! parts (the indicator state with its precomputed bases, one full λ-operator application),
-//! and a degenerate input (collinear points: GFI = 0, nothing to do).
+//! The `cali` method (Calì et al., docs/algorithms/cali.md §4.5) on noisy curves of n = 10², 10³,
+//! 10⁴ points, its parts (the indicator state with its precomputed bases, one full λ-operator
+//! application), and a degenerate input (collinear points: GFI = 0, nothing to do).
 //!
 //! With the paper's τ = 0.99 the number of accepted moves stops growing with n (one local move
 //! cannot lower a GFI spread over n points by 1 %, see the module docs of `fair::cali`), so the

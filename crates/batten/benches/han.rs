@@ -1,7 +1,8 @@
-//! The `han` method (Han et al., spec §1) for n = 10³ … 10⁶ points: the whole method with the
-//! default options (partition, 3 passes × 10 iterations per segment, blending) on the spiral of
-//! `benches/mst.rs`, the same on the spiral without its wobble at 10⁶ points, and one sweep (one iteration of the five case procedures C1, C2, C3, F1,
-//! F2) over a single function segment, so that the per-sweep cost is visible on its own.
+//! The `han` method (Han et al., docs/algorithms/han.md §1) for n = 10³ … 10⁶ points: the whole
+//! method with the default options (partition, 3 passes × 10 iterations per segment, blending) on
+//! the spiral of `benches/mst.rs`, the same on the spiral without its wobble at 10⁶ points, and one
+//! sweep (one iteration of the five case procedures C1, C2, C3, F1, F2) over a single function
+//! segment, so that the per-sweep cost is visible on its own.
 //!
 //! The 10⁶ whole-method case takes several seconds a run; Criterion may warn that it extended
 //! the measurement time.

@@ -1,6 +1,6 @@
-//! Kuragano & Yamaguchi (spec §5): uniform quintic interpolation (eq 8 with natural ends,
-//! eq 8 + eq 9 with four end gradients, and least squares with a gradient at every point) at
-//! n = 10³ … 10⁵ points, and the `kuragano` method (interpolant, ρ samples, degree-3
+//! Kuragano & Yamaguchi (docs/algorithms/kuragano.md §5): uniform quintic interpolation (eq 8 with
+//! natural ends, eq 8 + eq 9 with four end gradients, and least squares with a gradient at every
+//! point) at n = 10³ … 10⁵ points, and the `kuragano` method (interpolant, ρ samples, degree-3
 //! specification, Levenberg–Marquardt shape modification) at 10² … 10³ points.
 //!
 //! Run: `cargo bench -p batten --bench kuragano -- --warm-up-time 1 --measurement-time 3`

@@ -1,7 +1,8 @@
-//! Tests of the integral λ-operator (spec §4.2) and the `cali` fairing method (spec §4.3–4.6):
-//! operator identities against direct integral means, the vectors under "cali" in
-//! `tests/data/test-vectors.json`, the local LFI/GFI update against a full recomputation, the
-//! paper's strophoid test as the spec reads it, and the tolerance as a hard bound.
+//! Tests of the integral λ-operator (docs/algorithms/cali.md §4.2) and the `cali` fairing method
+//! (docs/algorithms/cali.md §4.3–4.6): operator identities against direct integral means, the
+//! vectors under "cali" in `tests/data/test-vectors.json`, the local LFI/GFI update against a full
+//! recomputation, the paper's strophoid test as the spec reads it, and the tolerance as a hard
+//! bound.
 
 mod common;
 
@@ -49,7 +50,7 @@ fn points(v: &Value) -> Vec<Point> {
         .collect()
 }
 
-/// `|got − exp| ≤ abs + rel·|exp|` element-wise (spec §7).
+/// `|got − exp| ≤ abs + rel·|exp|` element-wise (docs/algorithms/README.md §7).
 fn assert_close(what: &str, got: &[f64], exp: &[f64], tol: &Value) {
     let abs = tol["abs"].as_f64().expect("abs tolerance");
     let rel = tol["rel"].as_f64().expect("rel tolerance");
@@ -130,7 +131,7 @@ fn strophoid_curvature(t: f64) -> f64 {
 }
 
 /// 31 points of eq 30 equally spaced in t ∈ [−2, 2], 25 random interior ones perturbed by
-/// N(0, σ²) in both coordinates (spec §4.6).
+/// N(0, σ²) in both coordinates (docs/algorithms/cali.md §4.6).
 fn noisy_strophoid(sigma: f64, seed: u64) -> Vec<Point> {
     let mut rng = Rng::new(seed);
     let mut pts: Vec<Point> = (0..31)

@@ -1,8 +1,8 @@
 //! Correctness tests of the foundation: geometry, parametrisation, the parametric cubic, B-spline
 //! and NURBS evaluation and operations, curvature, arc length and the fairness measures.
 //!
-//! - the spec's vectors (`tests/data/test-vectors.json`, format in spec §7) that concern the
-//!   foundation: `common.*`, `sv.curvature_samples`, `sv.support_counts`,
+//! - the spec's vectors (`tests/data/test-vectors.json`, format in docs/algorithms/README.md §7)
+//!   that concern the foundation: `common.*`, `sv.curvature_samples`, `sv.support_counts`,
 //!   `cali.interpolation_and_gfi.strophoid31_clean`, `ky.basis.*`;
 //! - closed forms: circle curvature 1/R (exact NURBS circle and interpolants of 400 points),
 //!   the single inflection of y = x³ − x;
@@ -310,7 +310,8 @@ fn vector_cali_strophoid31_interpolation_and_gfi() {
     check(fi.gfi, e["GFI"].as_f64().unwrap(), tol, "GFI");
 }
 
-/// KY's uniform quintic (spec §5.1): knots −5..6, six control points, one segment t ∈ [0, 1].
+/// KY's uniform quintic (docs/algorithms/kuragano.md §5.1): knots −5..6, six control points, one
+/// segment t ∈ [0, 1].
 fn ky_quintic(ctrl: Vec<Point>) -> BSplineCurve {
     let knots = KnotVector::new((-5..=6).map(f64::from).collect());
     BSplineCurve::new(5, knots, ctrl, None)
@@ -369,10 +370,10 @@ fn vector_ky_basis_rows() {
         check_all(&b[r][..5], &exp, tol, &format!("r{r}"));
         check(b[r][5], 0.0, tol, &format!("r{r} coefficient of q_5"));
     }
-    // r = 3: the vector (and the table in spec §5.1) print (−1, −2, 0, 2, 1)/2, but the third
-    // derivative of eq 3 at t = 0 is (−60, 120, 0, −120, 60)/120 = (−1, 2, 0, −2, 1)/2, which
-    // is also ½(Δ³q_0 + Δ³q_1) (the quadratic B-spline values (½, ½) applied to the third
-    // differences). So the middle signs of the vector are checked flipped, and the rest of it
+    // r = 3: the vector (and the table in docs/algorithms/kuragano.md §5.1) print (−1, −2, 0, 2,
+    // 1)/2, but the third derivative of eq 3 at t = 0 is (−60, 120, 0, −120, 60)/120 = (−1, 2, 0,
+    // −2, 1)/2, which is also ½(Δ³q_0 + Δ³q_1) (the quadratic B-spline values (½, ½) applied to the
+    // third differences). So the middle signs of the vector are checked flipped, and the rest of it
     // as printed.
     let exp3 = f64s(&e["r3"]);
     let eq3_d3 = [

@@ -1,6 +1,7 @@
-//! Kjellander, Poliakoff, the energy-optimal move (spec §2) and Sapidis–Farin knot removal:
-//! the verified `kp.*` vectors (not `kp.example1.paper_table1`, which is not reproducible),
-//! the identities of spec §2.3–2.5, and the behaviour of the four registered methods.
+//! Kjellander, Poliakoff, the energy-optimal move (docs/algorithms/kjellander-poliakoff.md §2) and
+//! Sapidis–Farin knot removal: the verified `kp.*` vectors (not `kp.example1.paper_table1`, which
+//! is not reproducible), the identities of docs/algorithms/kjellander-poliakoff.md §2.3–2.5, and
+//! the behaviour of the four registered methods.
 
 #![allow(clippy::unwrap_used)]
 
@@ -308,7 +309,7 @@ fn kp_example2_first_step() {
 }
 
 // ---------------------------------------------------------------------------------------
-// Identities of spec §2.3–2.5.
+// Identities of docs/algorithms/kjellander-poliakoff.md §2.3–2.5.
 
 /// Random Hermite data: `n` points along x with bumps, tangents roughly along the curve.
 fn hermite_data() -> impl Strategy<Value = (Vec<f64>, Vec<Point>, Vec<Vec2>)> {

@@ -1,6 +1,6 @@
-//! B-spline surfaces: the principal-curvature vector of spec §0.6, curvatures against closed
-//! forms (an exact rational sphere patch, the saddle z = xy), derivatives against finite
-//! differences.
+//! B-spline surfaces: the principal-curvature vector of docs/algorithms/README.md §0.6, curvatures
+//! against closed forms (an exact rational sphere patch, the saddle z = xy), derivatives against
+//! finite differences.
 
 use batten::spline::KnotVector;
 use batten::surface::{BSplineSurface, Xyz};

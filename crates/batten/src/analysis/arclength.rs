@@ -1,4 +1,5 @@
-//! Arc length by Gauss–Legendre quadrature per span, and its inverse (spec §0.5).
+//! Arc length by Gauss–Legendre quadrature per span, and its inverse (docs/algorithms/README.md
+//! §0.5).
 
 use crate::curve::{CurveDeriv, Piecewise};
 use crate::numeric::GaussLegendre;

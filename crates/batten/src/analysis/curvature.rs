@@ -1,4 +1,5 @@
-//! Signed curvature and derived quantities (spec §0.1), energies (§0.4), comb samples.
+//! Signed curvature and derived quantities (docs/algorithms/README.md §0.1), energies (§0.4), comb
+//! samples.
 
 use serde::Serialize;
 
@@ -6,8 +7,9 @@ use crate::curve::{CurveDeriv, Derivatives, Piecewise};
 use crate::geom::{Point, Vec2};
 use crate::numeric::GaussLegendre;
 
-/// Signed curvature `κ = (x'y'' − y'x'') / (x'² + y'²)^{3/2}` from derivatives (spec §0.1);
-/// positive when the tangent turns counter-clockwise. Zero speed gives a non-finite value.
+/// Signed curvature `κ = (x'y'' − y'x'') / (x'² + y'²)^{3/2}` from derivatives
+/// (docs/algorithms/README.md §0.1); positive when the tangent turns counter-clockwise. Zero speed
+/// gives a non-finite value.
 #[inline]
 pub fn signed_curvature(d: &Derivatives) -> f64 {
     // sqrt of the squared length rather than hypot: this is the innermost call of every
@@ -16,7 +18,7 @@ pub fn signed_curvature(d: &Derivatives) -> f64 {
     d.d1.cross(d.d2) / (w * w.sqrt())
 }
 
-/// dκ/ds, the derivative of curvature with respect to arc length (spec §0.1):
+/// dκ/ds, the derivative of curvature with respect to arc length (docs/algorithms/README.md §0.1):
 /// `κ_t = [(r'×r''')|r'|² − 3(r'×r'')(r'·r'')] / |r'|⁵`, `dκ/ds = κ_t / |r'|`.
 #[inline]
 pub fn curvature_derivative(d: &Derivatives) -> f64 {
@@ -36,7 +38,7 @@ pub fn curvature_at<C: CurveDeriv + ?Sized>(curve: &C, t: f64) -> f64 {
     signed_curvature(&curve.derivatives(t))
 }
 
-/// `∫ κ² ds` (spec §0.4), by Gauss–Legendre quadrature on every span.
+/// `∫ κ² ds` (docs/algorithms/README.md §0.4), by Gauss–Legendre quadrature on every span.
 pub fn strain_energy<C: CurveDeriv + Piecewise + ?Sized>(curve: &C) -> f64 {
     integrate_spans(curve, |d| {
         let k = signed_curvature(d);

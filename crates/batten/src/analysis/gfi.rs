@@ -1,4 +1,4 @@
-//! Calì et al.'s local and global fairness indicators, LFI and GFI (spec §4.4).
+//! Calì et al.'s local and global fairness indicators, LFI and GFI (docs/algorithms/cali.md §4.4).
 //!
 //! `LFI_i = (κ''_i)²` with κ'' the second divided difference of the signed curvature with
 //! respect to arc length at the correspondence (Greville) points `ξ_i`, i = 1..m−1, and
@@ -32,7 +32,7 @@ pub struct FairnessIndicators {
     pub gfi: f64,
 }
 
-/// LFI and GFI of a B-spline curve (spec §4.4).
+/// LFI and GFI of a B-spline curve (docs/algorithms/cali.md §4.4).
 pub fn fairness_indicators(curve: &BSplineCurve) -> FairnessIndicators {
     let xi = curve.knots().greville(curve.degree());
     let cubic = curve.degree() == 3 && curve.weights().is_none();

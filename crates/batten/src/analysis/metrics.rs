@@ -1,4 +1,5 @@
-//! [`FairnessMetrics`]: the numbers every report carries (spec §0.3, §0.4, §4.4).
+//! [`FairnessMetrics`]: the numbers every report carries (docs/algorithms/README.md §0.3, §0.4,
+//! docs/algorithms/cali.md §4.4).
 
 use std::sync::OnceLock;
 
@@ -15,7 +16,8 @@ use crate::spline::{
     hermite_coeffs, parameters, span_derivatives,
 };
 
-/// Relative zero for sign tests (spec §1.7.0): `sgn0(v) = 0` when `|v| ≤ ZERO_REL·max|v_k|`.
+/// Relative zero for sign tests (docs/algorithms/han.md §1.7.0): `sgn0(v) = 0` when `|v| ≤
+/// ZERO_REL·max|v_k|`.
 pub const ZERO_REL: f64 = 1e-12;
 
 /// Samples per span for curvature extrema and the maximum curvature. The derivative of
@@ -165,7 +167,8 @@ fn count_sign_changes_above(values: &[f64], cyclic: bool, floor: f64) -> usize {
     runs.count(cyclic)
 }
 
-/// The sign of `v` with values within `ZERO_REL · scale` of zero counted as 0 (spec §1.7.0).
+/// The sign of `v` with values within `ZERO_REL · scale` of zero counted as 0
+/// (docs/algorithms/han.md §1.7.0).
 #[inline]
 pub fn sgn0(v: f64, scale: f64) -> i8 {
     if v.abs() <= ZERO_REL * scale {
@@ -212,7 +215,7 @@ pub struct FairnessMetrics {
     pub inflections: usize,
     /// Curvature vibrations (HAN's `Vib_num` on the parametric spline): sign changes of the
     /// jumps of dκ/ds at the interior knots. For a function graph the jump of dκ/ds at x_i
-    /// has the sign of HAN's `e_i` (spec §1.4).
+    /// has the sign of HAN's `e_i` (docs/algorithms/han.md §1.4).
     pub vibrations: usize,
     /// Local extrema of κ(s): the number of monotone pieces of the curvature plot minus one.
     pub curvature_extrema: usize,
@@ -222,8 +225,9 @@ pub struct FairnessMetrics {
     pub variation_energy: f64,
     /// Largest |κ| (sampled densely).
     pub max_curvature: f64,
-    /// Calì's global fairness indicator (spec §4.4) on the cubic B-spline interpolant with
-    /// averaging knots (open curves), or on the periodic spline at its knots (closed curves).
+    /// Calì's global fairness indicator (docs/algorithms/cali.md §4.4) on the cubic B-spline
+    /// interpolant with averaging knots (open curves), or on the periodic spline at its knots
+    /// (closed curves).
     pub gfi: f64,
     /// Largest `|r'''(t_k+) − r'''(t_k−)|` at the knots of the analysis curve (the bad-point
     /// measure of Kjellander and Poliakoff).

@@ -1,14 +1,15 @@
 //! `eck-hadenfeld`: local energy fairing of a B-spline curve, one control point at a time,
 //! after M. Eck and J. Hadenfeld, *Local energy fairing of B-spline curves* (Computing Suppl.
 //! 10, 1995), as Salvi and Várady review it (`../shared/papers/salvi-varady-local-fairing.txt`,
-//! §3.2, eqs 9–11); the selection, recently-moved list and clamp are those of spec §3
-//! (`../shared/spec/ALGORITHMS.md`, steps 5, 7, 8), shared with [`super::salvi`].
+//! §3.2, eqs 9–11); the selection, recently-moved list and clamp are those of
+//! docs/algorithms/salvi-varady.md §3 (`../shared/spec/ALGORITHMS.md`, steps 5, 7, 8), shared with
+//! [`super::salvi`].
 //!
 //! # The algorithm
 //!
-//! The energy (eq 9, which misses its `dt` in the print — spec §3 OCR notes) is
-//! `E_l = ∫ |x^{(l)}(t)|² dt` over the domain, `l = 2` or `3`. With knots and weights fixed,
-//! `x = Σ d_i R_i` is linear in the control points, so
+//! The energy (eq 9, which misses its `dt` in the print — docs/algorithms/salvi-varady.md §3 OCR
+//! notes) is `E_l = ∫ |x^{(l)}(t)|² dt` over the domain, `l = 2` or `3`. With knots and weights
+//! fixed, `x = Σ d_i R_i` is linear in the control points, so
 //! `E_l = Σ_a Σ_b G_ab d_a·d_b` with the Gram matrix `G_ab = ∫ R_a^{(l)} R_b^{(l)} dt` of the
 //! l-th derivatives of the (rational) basis functions. G is banded (`|a − b| ≤ p`); its band
 //! is computed once, span by span, by Gauss–Legendre quadrature ([`Gram`]): `p − l + 1` nodes
@@ -411,8 +412,8 @@ pub(super) fn energy(curve: &BSplineCurve, order: usize) -> Result<f64> {
     Ok(Gram::new(curve, order)?.energy(curve.control_points()))
 }
 
-/// Fair `curve` by local energy minimisation (see `docs/algorithms/salvi-varady.md`). Knots, degree and
-/// weights are kept; every control point stays within δ of its original position, so the
+/// Fair `curve` by local energy minimisation (see `docs/algorithms/salvi-varady.md`). Knots, degree
+/// and weights are kept; every control point stays within δ of its original position, so the
 /// curve stays within δ of `curve` (eq 10).
 ///
 /// # Errors

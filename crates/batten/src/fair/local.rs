@@ -5,14 +5,15 @@
 //! `../shared/spec/ALGORITHMS.md` §3.
 //!
 //! - [`support_ranges`]: the samples inside the support `[u_j, u_{j+k})` of each basis
-//!   function, the last span closed (spec §3 step 5);
+//!   function, the last span closed (docs/algorithms/salvi-varady.md §3 step 5);
 //! - [`RecentList`] and [`select_candidate`]: the largest local deviation among the control
 //!   points not moved recently, a FIFO tabu list of length R (default
-//!   [`DEFAULT_TABU_LENGTH`]) that is cleared when every candidate is in it (spec §3 step 5);
+//!   [`DEFAULT_TABU_LENGTH`]) that is cleared when every candidate is in it
+//!   (docs/algorithms/salvi-varady.md §3 step 5);
 //! - [`clamp_to_original`]: the eq-11 clamp `|d_r − d_r⁰| ≤ δ` relative to the **original**
-//!   control point (spec §3 step 7), which keeps the curve within δ of the original by the
-//!   convex-hull property and the partition of unity (eq 10);
-//! - [`principal_curvatures`] (spec §0.6) for the later surface version;
+//!   control point (docs/algorithms/salvi-varady.md §3 step 7), which keeps the curve within δ of
+//!   the original by the convex-hull property and the partition of unity (eq 10);
+//! - [`principal_curvatures`] (docs/algorithms/README.md §0.6) for the later surface version;
 //! - [`LocalReport`]: what a run did, as both methods' library entry points return it.
 //!
 //! The selection, the tabu list and the clamp do not know the dimension of a control point
@@ -30,7 +31,7 @@ use crate::error::{Error, Result};
 use crate::geom::{BBox, Point, PointSeq};
 use crate::spline::{BSplineCurve, KnotVector, Parametrization};
 
-/// Length R of the recently-moved list (spec §3 step 5).
+/// Length R of the recently-moved list (docs/algorithms/salvi-varady.md §3 step 5).
 pub(crate) const DEFAULT_TABU_LENGTH: usize = 4;
 
 /// Without a tolerance, δ is this fraction of the diagonal of the bounding box of the data
@@ -42,12 +43,13 @@ pub(crate) const DEFAULT_TOLERANCE_REL: f64 = 0.01;
 /// point past the tolerance the user asked for.
 pub(crate) const ROUNDING_MARGIN_ULPS: f64 = 64.0;
 
-/// Degree of the B-spline fitted to point input (global interpolation, spec §0.5).
+/// Degree of the B-spline fitted to point input (global interpolation, docs/algorithms/README.md
+/// §0.5).
 pub(crate) const DEFAULT_FIT_DEGREE: usize = 3;
 
-/// The eq-11 clamp (spec §3 step 7): when `|proposed − original| > δ`, return
-/// `original + δ·(proposed − original)/|proposed − original|`, else `proposed`. The flag says
-/// whether the clamp was active.
+/// The eq-11 clamp (docs/algorithms/salvi-varady.md §3 step 7): when `|proposed − original| > δ`,
+/// return `original + δ·(proposed − original)/|proposed − original|`, else `proposed`. The flag
+/// says whether the clamp was active.
 ///
 /// `original` is the control point of the *unfaired* curve, so a run of many moves never
 /// drifts farther than δ from it.
@@ -82,10 +84,10 @@ pub(crate) fn clamp_point(original: Point, proposed: Point, delta: f64) -> (Poin
 
 /// For every basis function `N_j` of a degree-`p` B-spline with `n_ctrl` control points, the
 /// index range of the samples inside its support `[u_j, u_{j+p+1})`, the last non-empty span
-/// closed (spec §3 step 5). A sample `t` belongs to `N_j` exactly when `j` is one of the
-/// `p + 1` functions of the span [`KnotVector::find_span`] returns for `t`, i.e. when moving
-/// `d_j` can change the curve at `t`. Functions whose support holds no sample get an empty
-/// range.
+/// closed (docs/algorithms/salvi-varady.md §3 step 5). A sample `t` belongs to `N_j` exactly when
+/// `j` is one of the `p + 1` functions of the span [`KnotVector::find_span`] returns for `t`, i.e.
+/// when moving `d_j` can change the curve at `t`. Functions whose support holds no sample get an
+/// empty range.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] when the samples are not finite and non-decreasing, or the
@@ -135,7 +137,8 @@ pub(crate) fn support_ranges(
 }
 
 /// `n ≥ 2` uniform parameters `t_i = t_min + i (t_max − t_min)/(n − 1)` over `domain`, the last
-/// one exactly `t_max` (spec §3 step 2). `n < 2` gives `[t_min]` or nothing.
+/// one exactly `t_max` (docs/algorithms/salvi-varady.md §3 step 2). `n < 2` gives `[t_min]` or
+/// nothing.
 pub(crate) fn uniform_samples(domain: (f64, f64), n: usize) -> Vec<f64> {
     let (a, b) = domain;
     match n {
@@ -151,9 +154,10 @@ pub(crate) fn uniform_samples(domain: (f64, f64), n: usize) -> Vec<f64> {
     }
 }
 
-/// The recently-moved list of spec §3 step 5: a FIFO of control-point indices of fixed
-/// capacity R (the oldest entry leaves when a new one arrives at capacity). It keeps the
-/// selection from moving the same point over and over, the deadlock the paper warns about.
+/// The recently-moved list of docs/algorithms/salvi-varady.md §3 step 5: a FIFO of control-point
+/// indices of fixed capacity R (the oldest entry leaves when a new one arrives at capacity). It
+/// keeps the selection from moving the same point over and over, the deadlock the paper warns
+/// about.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub(crate) struct RecentList {
     items: VecDeque<usize>,
@@ -203,9 +207,9 @@ impl RecentList {
     }
 }
 
-/// The next control point to move (spec §3 step 5): the movable index with the largest
-/// `deviation` that is not in `recent`. When every movable index is in `recent`, the list is
-/// cleared and the largest deviation overall wins. Ties go to the lowest index; NaN
+/// The next control point to move (docs/algorithms/salvi-varady.md §3 step 5): the movable index
+/// with the largest `deviation` that is not in `recent`. When every movable index is in `recent`,
+/// the list is cleared and the largest deviation overall wins. Ties go to the lowest index; NaN
 /// deviations rank below every number. `None` when nothing is movable.
 ///
 /// # Panics
@@ -239,8 +243,8 @@ pub(crate) fn select_candidate(
 }
 
 /// Principal curvatures of a parametric surface from its first and second partial
-/// derivatives (spec §0.6): `n = S_u × S_v / |S_u × S_v|`, the fundamental forms E, F, G and
-/// L, M, N, `K = (LN − M²)/(EG − F²)`, `H = (EN − 2FM + GL)/(2(EG − F²))`,
+/// derivatives (docs/algorithms/README.md §0.6): `n = S_u × S_v / |S_u × S_v|`, the fundamental
+/// forms E, F, G and L, M, N, `K = (LN − M²)/(EG − F²)`, `H = (EN − 2FM + GL)/(2(EG − F²))`,
 /// `κ1,2 = H ± sqrt(max(H² − K, 0))`. Signs follow the orientation of `n`.
 ///
 /// `None` where the surface is singular (`S_u × S_v = 0`, or non-finite input).
@@ -410,10 +414,10 @@ impl RunningMax {
     }
 }
 
-/// Movable control points: all but `held` at each end (spec §3 step 5: boundary control
-/// points are excluded, as the paper recommends; `held` is 0 with `free_ends`, 1 by default,
-/// 2 or 3 with `--fix-ends=tangent` / `curvature`, which keep the clamped curve's end tangents
-/// and curvatures).
+/// Movable control points: all but `held` at each end (docs/algorithms/salvi-varady.md §3 step 5:
+/// boundary control points are excluded, as the paper recommends; `held` is 0 with `free_ends`, 1
+/// by default, 2 or 3 with `--fix-ends=tangent` / `curvature`, which keep the clamped curve's end
+/// tangents and curvatures).
 pub(crate) fn movable_mask(n_ctrl: usize, held: usize) -> Vec<bool> {
     let mut m = vec![true; n_ctrl];
     let held = held.min(n_ctrl);
@@ -526,8 +530,8 @@ pub(crate) struct FittedInput {
     pub parameters: serde_json::Map<String, serde_json::Value>,
 }
 
-/// Fit point input with a B-spline (spec §0.5): global interpolation with chord-length
-/// parameters by default, least squares with `control_points = N`; and choose δ.
+/// Fit point input with a B-spline (docs/algorithms/README.md §0.5): global interpolation with
+/// chord-length parameters by default, least squares with `control_points = N`; and choose δ.
 ///
 /// With a tolerance `D`, δ = `D − residual − margin` ([`ROUNDING_MARGIN_ULPS`]), so that an
 /// output point (the faired curve at the input's parameter) is within `D` of the input point:

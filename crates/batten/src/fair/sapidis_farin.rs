@@ -6,8 +6,8 @@
 //! `../shared/papers/kjellander-poliakoff-improved.txt`); G. Farin, *Curves and Surfaces for
 //! CAGD*, the section on fairing by knot removal. The five papers of the spec do not cover
 //! this method: the local formula below is derived here, and the greedy loop, stopping rule
-//! and tolerance handling are those of the Kjellander–Poliakoff family (spec §2.6, module
-//! [`super::kjellander`]).
+//! and tolerance handling are those of the Kjellander–Poliakoff family
+//! (docs/algorithms/kjellander-poliakoff.md §2.6, module [`super::kjellander`]).
 //!
 //! # The local formula (remove and reinsert one knot)
 //!
@@ -150,9 +150,9 @@ fn farin_point(ctrl: &[Point], u: &[f64], j: usize) -> Point {
 }
 
 /// Remove the simple interior knot `u_j` (knot index `j`) of a non-rational cubic B-spline
-/// and reinsert it (Farin's local formula, see `docs/algorithms/kjellander-poliakoff.md`). The result has the same
-/// knot vector, differs from `curve` in the control point `j − 2` only, and its third
-/// derivative is continuous at `u_j`.
+/// and reinsert it (Farin's local formula, see `docs/algorithms/kjellander-poliakoff.md`). The
+/// result has the same knot vector, differs from `curve` in the control point `j − 2` only, and its
+/// third derivative is continuous at `u_j`.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for a degree other than 3, a rational curve, or a `j` that is

@@ -13,7 +13,7 @@ const GOLDEN: f64 = 0.381_966_011_250_105_1; // (3 − √5)/2
 
 /// Golden-section search for a minimum of `f` on `[a, b]` to absolute tolerance `tol` in x.
 /// The two end points are evaluated too, and the best of all evaluated points is returned, so
-/// a minimum at the boundary of the interval is found (spec §4.5).
+/// a minimum at the boundary of the interval is found (docs/algorithms/cali.md §4.5).
 pub fn minimize_golden(mut f: impl FnMut(f64) -> f64, a: f64, b: f64, tol: f64) -> Minimum {
     let (mut lo, mut hi) = if a <= b { (a, b) } else { (b, a) };
     let tol = tol.max(f64::EPSILON * (lo.abs() + hi.abs()));

@@ -38,7 +38,7 @@ pub struct NelderMeadParams {
     pub xatol: f64,
     /// Stop after this many function evaluations.
     ///
-    /// Default value: `400` (spec §3 step 6).
+    /// Default value: `400` (docs/algorithms/salvi-varady.md §3 step 6).
     pub max_evaluations: usize,
 }
 

@@ -10,7 +10,8 @@ pub struct GaussLegendre {
 
 impl GaussLegendre {
     /// Default node count per knot span for arc length and energies: ample for the
-    /// piecewise-polynomial integrands of splines up to degree five (see spec §0.5).
+    /// piecewise-polynomial integrands of splines up to degree five (see docs/algorithms/README.md
+    /// §0.5).
     pub const DEFAULT_NODES: usize = 16;
 
     /// The rule with `n ≥ 1` nodes on [−1, 1].

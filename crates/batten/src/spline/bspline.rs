@@ -8,8 +8,8 @@ use crate::geom::{Point, Vec2};
 /// A planar B-spline curve of any degree `p ≥ 1`, optionally rational (NURBS).
 ///
 /// `x(t) = Σ_i w_i P_i N_{i,p}(t) / Σ_i w_i N_{i,p}(t)` with `m + 1` control points and a knot
-/// vector of `m + p + 2` knots (spec §0.5). The domain is `[u_p, u_{m+1}]`; at its end the
-/// last non-empty span is used.
+/// vector of `m + p + 2` knots (docs/algorithms/README.md §0.5). The domain is `[u_p, u_{m+1}]`; at
+/// its end the last non-empty span is used.
 ///
 /// Serialised as `{"degree": p, "knots": [...], "control_points": [[x, y], ...],
 /// "weights": [...]}` (weights omitted when all are 1).

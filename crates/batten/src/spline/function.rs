@@ -1,5 +1,6 @@
 //! The cubic spline *function* `y(x)` through points with strictly increasing abscissae
-//! (HAN, spec §1.2–§1.3, §1.5; paper `shared/papers/han-explicit-fairing-indicator.txt`, eqs 2–10).
+//! (HAN, docs/algorithms/han.md §1.2–§1.3, §1.5; paper
+//! `shared/papers/han-explicit-fairing-indicator.txt`, eqs 2–10).
 //!
 //! The spline is stored by its values `y_i` and the scaled second derivatives
 //! `c_i = y''(x_i)/6` (the paper's notation). On `[x_i, x_{i+1}]` (eq 2)
@@ -19,7 +20,7 @@
 //! plus one of the three end conditions of the paper ([`FnEndCondition`]). The system is solved
 //! in O(n) by the forward sweep `c_i + a_i c_{i+1} = b_i` (eqs 5–6) and the backward sweep
 //! `c_i + a*_i c_{i−1} = b*_i` (eqs 7–8); both are kept because HAN's unit spline responses are
-//! built from `a` and `a*` (spec §1.6).
+//! built from `a` and `a*` (docs/algorithms/han.md §1.6).
 //!
 //! Indices in this API are 0-based: point `k` here is the paper's point `k + 1`.
 
@@ -73,7 +74,7 @@ impl FnEndCondition {
 }
 
 /// A C² cubic spline function `y(x)` interpolating `(x_i, y_i)` with `x` strictly increasing
-/// (HAN eqs 1–10, spec §1.2–§1.3).
+/// (HAN eqs 1–10, docs/algorithms/han.md §1.2–§1.3).
 ///
 /// As a [`Curve`] it is the graph `t ↦ (t, y(t))` on `[x_1, x_n]`; outside that interval the
 /// first or last cubic piece is extrapolated.
@@ -291,8 +292,8 @@ impl CubicSplineFn {
     }
 
     /// HAN's indicator `e_i = (c_{i+1} − c_i)/h_i − (c_i − c_{i−1})/h_{i−1}` for the interior
-    /// points, with `e_1 = e_n = 0` (spec §0.3, §1.5 \[CHOICE\]: the x–c plot extended flat).
-    /// `6 e_i` is the jump of `y'''` at `x_i`. Length n.
+    /// points, with `e_1 = e_n = 0` (docs/algorithms/README.md §0.3, docs/algorithms/han.md §1.5
+    /// \[CHOICE\]: the x–c plot extended flat). `6 e_i` is the jump of `y'''` at `x_i`. Length n.
     pub fn indicator(&self) -> Vec<f64> {
         let n = self.len();
         let mut e = vec![0.0; n];

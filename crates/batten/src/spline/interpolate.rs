@@ -1,5 +1,5 @@
-//! Global B-spline interpolation through points (spec §4.3: chord-length parameters normalised
-//! to [0, 1], averaging knots, clamped ends; Piegl & Tiller §9.2.1).
+//! Global B-spline interpolation through points (docs/algorithms/cali.md §4.3: chord-length
+//! parameters normalised to [0, 1], averaging knots, clamped ends; Piegl & Tiller §9.2.1).
 
 use super::{BSplineCurve, KnotVector, MAX_ORDER, Parametrization, basis_derivs, parameters};
 use crate::error::{Error, Result};

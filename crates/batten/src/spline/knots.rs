@@ -86,7 +86,7 @@ impl KnotVector {
 
     /// The index `k` of the span `[u_k, u_{k+1})` of a degree-`p` curve with `n_ctrl`
     /// control points that contains `t`, clamped to `p..=n_ctrl−1`: the last non-empty span
-    /// is used for `t` at (or beyond) the end of the domain (spec §0.5).
+    /// is used for `t` at (or beyond) the end of the domain (docs/algorithms/README.md §0.5).
     pub fn find_span(&self, p: usize, n_ctrl: usize, t: f64) -> usize {
         let u = &self.0;
         let hi = n_ctrl - 1;
@@ -138,7 +138,8 @@ impl KnotVector {
     }
 
     /// The Greville (Schoenberg, "correspondence") abscissae of a degree-`p` spline on these
-    /// knots: `ξ_i = (u_{i+1} + … + u_{i+p}) / p`, one per control point (spec §0.5).
+    /// knots: `ξ_i = (u_{i+1} + … + u_{i+p}) / p`, one per control point (docs/algorithms/README.md
+    /// §0.5).
     pub fn greville(&self, p: usize) -> Vec<f64> {
         let u = &self.0;
         let n = u.len().saturating_sub(p + 1);

@@ -1,7 +1,7 @@
 //! The variation-diminishing spline operator and the integral λ-operator of Milovanović and
 //! Kocić, as used by Calì, Miglio, Moroni and Rasella, *Curve fairing using integral spline
 //! operators* (`../shared/papers/cali-integral-spline-operators.txt`, §3, eqs 5–23), in the
-//! clamped 0-based notation of spec §4.1–4.2 (`../shared/spec/ALGORITHMS.md`).
+//! clamped 0-based notation of docs/algorithms/cali.md §4.1–4.2 (`../shared/spec/ALGORITHMS.md`).
 //!
 //! For a degree-p clamped knot vector `u_0..u_{m+p+1}` and control points `P_0..P_m`:
 //!
@@ -33,22 +33,23 @@
 //!
 //! Degenerate knots: an interior knot of multiplicity p + 1 makes two consecutive Greville
 //! points coincide (`ξ_{i−1} = ξ_i`); the averaging interval then has no part on that side
-//! (`ξ_i − η_i = 0`), so the coefficient is 0 (the 0/0 := 0 convention of spec §0.5). Ratios
-//! are clamped to their exact range [0, 1] so that rounding never produces a negative or
-//! oversized weight.
+//! (`ξ_i − η_i = 0`), so the coefficient is 0 (the 0/0 := 0 convention of docs/algorithms/README.md
+//! §0.5). Ratios are clamped to their exact range [0, 1] so that rounding never produces a negative
+//! or oversized weight.
 
 use super::{BSplineCurve, KnotVector};
 use crate::error::{Error, Result};
 use crate::geom::Point;
 
-/// How many control points on each side of the centre a local move changes (spec §4.5:
-/// the set `L_i = {P_{i−2}, …, P_{i+2}}`).
+/// How many control points on each side of the centre a local move changes (docs/algorithms/cali.md
+/// §4.5: the set `L_i = {P_{i−2}, …, P_{i+2}}`).
 pub const LOCAL_HALF_WIDTH: usize = 2;
 
 /// The number of control points a local move changes: `2·LOCAL_HALF_WIDTH + 1 = 5`.
 pub const LOCAL_WIDTH: usize = 2 * LOCAL_HALF_WIDTH + 1;
 
-/// The integral λ-operator `M^λ` of a clamped knot vector (spec §4.2), built once in O(m).
+/// The integral λ-operator `M^λ` of a clamped knot vector (docs/algorithms/cali.md §4.2), built
+/// once in O(m).
 ///
 /// Holds the correspondence points ξ, the points η and the coefficients α, β, γ; applying
 /// the operator to a control polygon (whole or locally) is then O(1) per control point.
@@ -225,7 +226,8 @@ impl LambdaOperator {
     }
 
     /// The five new control points `(M^λ P)_j`, j = i−2..=i+2, of a local move centred at
-    /// `i` (spec §4.5 step 3.1), computed from the current `points`; nothing else changes.
+    /// `i` (docs/algorithms/cali.md §4.5 step 3.1), computed from the current `points`; nothing
+    /// else changes.
     ///
     /// # Errors
     /// [`Error::LengthMismatch`], [`Error::InvalidParameter`] for λ outside [0, 1] or a

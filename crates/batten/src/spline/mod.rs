@@ -1,8 +1,8 @@
 //! Spline representations and their constructors.
 //!
 //! - [`ParametricCubic`]: the C² cubic interpolating spline through planar points;
-//! - [`CubicSplineFn`]: the cubic spline *function* y(x) of HAN (spec §1.2), end conditions
-//!   [`FnEndCondition`];
+//! - [`CubicSplineFn`]: the cubic spline *function* y(x) of HAN (docs/algorithms/han.md §1.2), end
+//!   conditions [`FnEndCondition`];
 //! - [`KnotVector`] and [`BSplineCurve`]: B-spline / NURBS curves of any degree, with knot
 //!   insertion and removal ([`KnotRemoval`], [`RemovalRule`], [`KnotRef`]);
 //! - [`LambdaOperator`]: the λ-operator of Calì et al.;

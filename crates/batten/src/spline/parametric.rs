@@ -1,4 +1,5 @@
-//! The C² parametric cubic interpolating spline through planar points (spec §0.2, §2.1).
+//! The C² parametric cubic interpolating spline through planar points (docs/algorithms/README.md
+//! §0.2, docs/algorithms/kjellander-poliakoff.md §2.1).
 
 use serde::{Deserialize, Serialize};
 
@@ -10,7 +11,7 @@ use std::ops::Div;
 use super::knots::break_span;
 use crate::numeric::{Linear, solve_cyclic_tridiagonal, solve_tridiagonal};
 
-/// How parameter values are assigned to a point sequence (spec §0.2).
+/// How parameter values are assigned to a point sequence (docs/algorithms/README.md §0.2).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Parametrization {

@@ -2,7 +2,7 @@
 //! and fairness evaluation* (`../shared/papers/kuragano-nurbs-roc-fairness.txt`, §2–§3), as
 //! specified in `../shared/spec/ALGORITHMS.md` §5.1 and §5.3.
 //!
-//! # Representation (eqs 1–4, spec §5.1)
+//! # Representation (eqs 1–4, docs/algorithms/kuragano.md §5.1)
 //!
 //! `n` control points `q_0..q_{n−1}` (n ≥ 6) and the uniform knots `−5, −4, …, n` give `n − 5`
 //! segments; segment `i` uses `q_i..q_{i+5}` and the global parameter `u ∈ [i, i + 1]`, so the
@@ -13,11 +13,12 @@
 //! on `q_i..q_{i+4}`: row 0 is eq 8 (`(1, 26, 66, 26, 1)/120`), row 1 is eq 9
 //! (`(−1, −10, 0, 10, 1)/24`), rows 2 and 4 give the end conditions.
 //!
-//! # Constructors (spec §5.3)
+//! # Constructors (docs/algorithms/kuragano.md §5.3)
 //!
 //! - [`interpolate`] with [`Ends::Natural`]: `m` points give `m + 4` unknowns; eq 8 at
 //!   `i = 0..m−1` (point `P_i` at `u = i`) plus `R'' = 0` and `R'''' = 0` at both ends. The
-//!   curvature is zero at both ends, so ρ is infinite there (spec §5.3, "keep this in mind").
+//!   curvature is zero at both ends, so ρ is infinite there (docs/algorithms/kuragano.md §5.3,
+//!   "keep this in mind").
 //! - [`interpolate`] with [`Ends::Gradients`]: four gradients `R'(u = i) = d_i` (eq 9) at
 //!   distinct point indices replace the end conditions. [`end_gradients`] makes the default:
 //!   locations `0, 1, m−2, m−1` (the paper's "0, 1, n−2, n−1" reuses n for m), directions
@@ -49,7 +50,8 @@ pub(crate) const DEGREE: usize = 5;
 pub(crate) const STENCIL_WIDTH: usize = 5;
 
 /// `d^r R/dt^r` at `t = 0` of segment `i`, as coefficients of `q_i..q_{i+4}`, for r = 0..4
-/// (spec §5.1 table). Row 0 is eq 8, row 1 eq 9, rows 2 and 4 the end conditions.
+/// (docs/algorithms/kuragano.md §5.1 table). Row 0 is eq 8, row 1 eq 9, rows 2 and 4 the end
+/// conditions.
 ///
 /// **\[FIX\]** Row 3 is `(−1, 2, 0, −2, 1)/2`, not the spec table's `(−1, −2, 0, 2, 1)/2`: eq 3
 /// gives `N_1'''(0) = 6·20/120 = 1`, de Boor–Cox agrees, and only this row reproduces cubics
@@ -143,10 +145,10 @@ pub enum QuinticForm {
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub enum Ends {
-    /// `R'' = 0` and `R'''' = 0` at both ends (spec §5.3.1).
+    /// `R'' = 0` and `R'''' = 0` at both ends (docs/algorithms/kuragano.md §5.3.1).
     Natural,
     /// Exactly four gradients `(point index, dR/du)` at distinct point indices, replacing the
-    /// end conditions (eq 9, spec §5.3.2).
+    /// end conditions (eq 9, docs/algorithms/kuragano.md §5.3.2).
     Gradients(Vec<(usize, Vec2)>),
 }
 
@@ -210,10 +212,10 @@ pub(crate) fn is_uniform_quintic(curve: &BSplineCurve) -> bool {
         && curve.weights().is_none_or(|w| w.iter().all(|&x| x == 1.0))
 }
 
-/// The default gradients of spec §5.3.2: at point indices `0, 1, m−2, m−1`, in the direction
-/// of the parabola through three neighbouring points (`(−3P_0 + 4P_1 − P_2)/2` at the start,
-/// `(P_{i+1} − P_{i−1})/2` inside, mirrored at the end; the chord when `m < 3`), with length
-/// `fraction` times the adjacent chord. The adjacent chord is the one on the side of the
+/// The default gradients of docs/algorithms/kuragano.md §5.3.2: at point indices `0, 1, m−2, m−1`,
+/// in the direction of the parabola through three neighbouring points (`(−3P_0 + 4P_1 − P_2)/2` at
+/// the start, `(P_{i+1} − P_{i−1})/2` inside, mirrored at the end; the chord when `m < 3`), with
+/// length `fraction` times the adjacent chord. The adjacent chord is the one on the side of the
 /// nearer end (`|P_1 − P_0|` for indices 0 and 1, `|P_{m−1} − P_{m−2}|` for `m−2` and `m−1`).
 ///
 /// # Errors
@@ -288,11 +290,12 @@ struct StencilRow {
 }
 
 /// The uniform quintic through `points` (point `P_i` at `u = i`) with the given end
-/// conditions (spec §5.3.1–2). The result has `m + 4` control points and `m − 1` segments.
+/// conditions (docs/algorithms/kuragano.md §5.3.1–2). The result has `m + 4` control points and `m
+/// − 1` segments.
 ///
 /// # Errors
 /// [`Error::TooFewPoints`] (fewer than two points; fewer than four with gradients),
-/// [`Error::NonFinite`], [`Error::DuplicatePoint`] (a zero chord, spec §0.2),
+/// [`Error::NonFinite`], [`Error::DuplicatePoint`] (a zero chord, docs/algorithms/README.md §0.2),
 /// [`Error::InvalidParameter`] for gradients that are not four, at indices out of range or
 /// repeated, and [`Error::Singular`] if the system cannot be solved.
 pub fn interpolate(points: &[Point], ends: &Ends, form: QuinticForm) -> Result<BSplineCurve> {
@@ -359,8 +362,8 @@ pub fn interpolate(points: &[Point], ends: &Ends, form: QuinticForm) -> Result<B
 }
 
 /// The uniform quintic through `points` with a gradient `dR/du` at every point (paper §3.2,
-/// spec §5.3.3): exact for `m = 4`, least squares for `m > 4`, and for `m < 4` the exact
-/// solution with the least `Σ |q_{j+1} − 2q_j + q_{j−1}|²` (spec \[CHOICE\]).
+/// docs/algorithms/kuragano.md §5.3.3): exact for `m = 4`, least squares for `m > 4`, and for `m <
+/// 4` the exact solution with the least `Σ |q_{j+1} − 2q_j + q_{j−1}|²` (spec \[CHOICE\]).
 ///
 /// # Errors
 /// [`Error::TooFewPoints`] (fewer than two), [`Error::LengthMismatch`] when the gradient

@@ -2,8 +2,8 @@
 //!
 //! - [`BSplineSurface`]: a tensor-product B-spline or NURBS surface of any degrees on clamped
 //!   knots, with partial derivatives up to second order, the normal, the fundamental forms and
-//!   the principal, Gaussian and mean curvatures (spec §0.6, κ1 ≥ κ2, signs following
-//!   `S_u × S_v`).
+//!   the principal, Gaussian and mean curvatures (docs/algorithms/README.md §0.6, κ1 ≥ κ2, signs
+//!   following `S_u × S_v`).
 //! - [`interpolate_grid`]: the bicubic through a regular grid of points (scanned patches).
 //! - [`analyze_surface`]: curvature ranges, umbilics and the fairness measure Π̂ on the
 //!   documented grid of [`SampleGrid::for_surface`]; [`Targets`]: the smooth target

@@ -1,7 +1,7 @@
 //! [`BSplineSurface`]: a tensor-product B-spline or NURBS surface
 //! `S(u, v) = Σ_i Σ_j w_ij P_ij N_i(u) N_j(v) / Σ_i Σ_j w_ij N_i(u) N_j(v)` (Salvi & Várady
 //! eq 12, with optional weights), its partial derivatives up to second order and the
-//! differential geometry built on them (spec §0.6).
+//! differential geometry built on them (docs/algorithms/README.md §0.6).
 
 use crate::error::{Error, Result};
 use crate::fair::local::principal_curvatures;
@@ -60,8 +60,8 @@ pub struct FundamentalForms {
     pub normal: Xyz,
 }
 
-/// Curvatures at one point (spec §0.6): `κ1 ≥ κ2`, `K = κ1 κ2`, `H = (κ1 + κ2)/2`, signs
-/// following the normal `S_u × S_v`.
+/// Curvatures at one point (docs/algorithms/README.md §0.6): `κ1 ≥ κ2`, `K = κ1 κ2`, `H = (κ1 +
+/// κ2)/2`, signs following the normal `S_u × S_v`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SurfaceCurvature {
     /// The larger principal curvature.
@@ -324,8 +324,8 @@ impl BSplineSurface {
         forms(&self.derivatives(u, v))
     }
 
-    /// Principal, Gaussian and mean curvature at `(u, v)` (spec §0.6), `None` at a singular
-    /// point (`S_u × S_v = 0`).
+    /// Principal, Gaussian and mean curvature at `(u, v)` (docs/algorithms/README.md §0.6), `None`
+    /// at a singular point (`S_u × S_v = 0`).
     pub fn curvature(&self, u: f64, v: f64) -> Option<SurfaceCurvature> {
         curvature_of(&self.derivatives(u, v))
     }
@@ -412,8 +412,8 @@ pub(crate) fn forms(d: &SurfaceDerivs) -> Option<FundamentalForms> {
     })
 }
 
-/// Curvatures from the partial derivatives (spec §0.6, through the curve code's
-/// [`principal_curvatures`]).
+/// Curvatures from the partial derivatives (docs/algorithms/README.md §0.6, through the curve
+/// code's [`principal_curvatures`]).
 pub(crate) fn curvature_of(d: &SurfaceDerivs) -> Option<SurfaceCurvature> {
     let pc = principal_curvatures(d.su, d.sv, d.suu, d.suv, d.svv)?;
     Some(SurfaceCurvature {

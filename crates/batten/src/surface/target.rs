@@ -1,5 +1,5 @@
-//! The target curvatures g1, g2 of Salvi & Várady's surface algorithm (eqs 16–17, spec §3
-//! "Surface algorithm" step 3).
+//! The target curvatures g1, g2 of Salvi & Várady's surface algorithm (eqs 16–17,
+//! docs/algorithms/salvi-varady.md §3 "Surface algorithm" step 3).
 //!
 //! Each principal-curvature field κ_q sampled on the grid is approximated by a bicubic
 //! B-spline *function* `g(x, y) = Σ c_ab M_a(x) M_b(y)` over the parameter domain mapped to

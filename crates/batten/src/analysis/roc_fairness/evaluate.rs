@@ -1,6 +1,7 @@
-//! The fairness evaluation of a design (paper §5, spec §5.6): the specification and the shape
-//! modification for every applicable degree, the cosine of the designed and the modified ρ
-//! samples, and the best degree (`docs/algorithms/kuragano.md`, "Fairness evaluation").
+//! The fairness evaluation of a design (paper §5, docs/algorithms/kuragano.md §5.6): the
+//! specification and the shape modification for every applicable degree, the cosine of the designed
+//! and the modified ρ samples, and the best degree (`docs/algorithms/kuragano.md`, "Fairness
+//! evaluation").
 
 use serde::Serialize;
 
@@ -14,8 +15,9 @@ use crate::geom::Point;
 use crate::spline::BSplineCurve;
 use crate::spline::quintic::{self, Ends, QuinticForm};
 
-/// Cosines within this of the largest are a tie, resolved to the lowest degree (spec §5.6):
-/// a higher degree is chosen only when it follows the design's ρ better by more than this.
+/// Cosines within this of the largest are a tie, resolved to the lowest degree
+/// (docs/algorithms/kuragano.md §5.6): a higher degree is chosen only when it follows the design's
+/// ρ better by more than this.
 ///
 /// The paper breaks ties at its printed precision (Table 3 prints three decimals, Table 4
 /// the angle to 0.01°). 10⁻⁴ is the size of what separates degrees on exact samples of
@@ -34,8 +36,8 @@ pub const TIE_TOLERANCE: f64 = 1e-4;
 #[cfg(test)]
 pub(super) const PAPER_TIE_TOLERANCE: f64 = 1e-6;
 
-/// The cosine of two sample vectors, not mean-centred (spec §5.6 step 2); `None` when either
-/// is zero.
+/// The cosine of two sample vectors, not mean-centred (docs/algorithms/kuragano.md §5.6 step 2);
+/// `None` when either is zero.
 pub(super) fn cosine(a: &[f64], b: &[f64]) -> Option<f64> {
     let dot: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
     let na = a.iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -43,7 +45,7 @@ pub(super) fn cosine(a: &[f64], b: &[f64]) -> Option<f64> {
     (na > 0.0 && nb > 0.0).then(|| (dot / (na * nb)).clamp(-1.0, 1.0))
 }
 
-/// The angle `arccos(cos)` in degrees (spec §5.6 step 3).
+/// The angle `arccos(cos)` in degrees (docs/algorithms/kuragano.md §5.6 step 3).
 pub fn angle_degrees(cos: f64) -> f64 {
     cos.clamp(-1.0, 1.0).acos().to_degrees()
 }
@@ -53,7 +55,7 @@ pub fn angle_degrees(cos: f64) -> f64 {
 const TRUNCATE_GUARD_REL: f64 = 1e-9;
 
 /// Truncate (not round) a non-negative angle to `decimals` places, as the paper's Table 4
-/// and text print it (spec §5.6 step 3): 3.0061° → 3.00, 1.1459° → 1.14.
+/// and text print it (docs/algorithms/kuragano.md §5.6 step 3): 3.0061° → 3.00, 1.1459° → 1.14.
 pub fn truncate_angle(deg: f64, decimals: u32) -> f64 {
     let f = 10f64.powi(decimals as i32);
     let scaled = deg * f;
@@ -110,7 +112,7 @@ pub struct DegreeResult {
     pub rho_rms: Option<f64>,
 }
 
-/// The fairness evaluation of a design (paper §5, spec §5.6). Serialised as
+/// The fairness evaluation of a design (paper §5, docs/algorithms/kuragano.md §5.6). Serialised as
 /// `{"degrees": [{"degree", "applicable", "correlation", "angle_deg"}, ...],
 /// "best_degree", "fairness"}`, with `null` where a value does not exist.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -155,9 +157,9 @@ impl Evaluation {
     }
 }
 
-/// The selected row (spec §5.6 step 4): the applicable row with the largest correlation, where
-/// correlations within [`TIE_TOLERANCE`] of the largest tie and the lowest degree wins.
-/// `None` when no row has a correlation.
+/// The selected row (docs/algorithms/kuragano.md §5.6 step 4): the applicable row with the largest
+/// correlation, where correlations within [`TIE_TOLERANCE`] of the largest tie and the lowest
+/// degree wins. `None` when no row has a correlation.
 pub(super) fn select_best(rows: &[DegreeResult]) -> Option<&DegreeResult> {
     select_best_within(rows, TIE_TOLERANCE)
 }
@@ -289,10 +291,10 @@ pub(crate) fn evaluate_detailed(
     })
 }
 
-/// The fairness evaluation of a design (paper §5, spec §5.6): for every applicable degree
-/// d = 1..6 the specification `ρ̂_d` and the shape modification towards it, then the cosine
-/// of the designed and the modified ρ samples. A design with an inflection (or straight) has
-/// no applicable degree: every row is not applicable and `best_degree` is `None`.
+/// The fairness evaluation of a design (paper §5, docs/algorithms/kuragano.md §5.6): for every
+/// applicable degree d = 1..6 the specification `ρ̂_d` and the shape modification towards it, then
+/// the cosine of the designed and the modified ρ samples. A design with an inflection (or straight)
+/// has no applicable degree: every row is not applicable and `best_degree` is `None`.
 ///
 /// ```
 /// use batten::Point;

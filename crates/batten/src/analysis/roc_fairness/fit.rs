@@ -1,6 +1,6 @@
 //! The specification `ρ̂(s)`: a least-squares polynomial of degree 1..=6 in the normalised arc
-//! length, on the Chebyshev basis (spec §5.4 step 3; `docs/algorithms/kuragano.md`,
-//! "Radius-of-curvature specification").
+//! length, on the Chebyshev basis (docs/algorithms/kuragano.md §5.4 step 3;
+//! `docs/algorithms/kuragano.md`, "Radius-of-curvature specification").
 
 use crate::error::{Error, Result};
 
@@ -10,8 +10,8 @@ pub(crate) const MIN_DEGREE: usize = 1;
 /// Highest polynomial degree of the specification ("six degrees", paper §5).
 pub(crate) const MAX_DEGREE: usize = 6;
 
-/// A least-squares polynomial `ρ̂(s)` of degree d on [0, 1] (spec §5.4 step 3), held in the
-/// Chebyshev basis `T_k(2s − 1)`.
+/// A least-squares polynomial `ρ̂(s)` of degree d on [0, 1] (docs/algorithms/kuragano.md §5.4 step
+/// 3), held in the Chebyshev basis `T_k(2s − 1)`.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct RhoFit {
     degree: usize,

@@ -1,6 +1,6 @@
-//! The shape modification of spec §5.5 (paper eqs 10–13): the interior control points move to
-//! minimise `S = Σ δ_i²` towards a fixed `ρ̂`, by Levenberg–Marquardt on the banded normal
-//! equations (`docs/algorithms/kuragano.md`, "Shape modification").
+//! The shape modification of docs/algorithms/kuragano.md §5.5 (paper eqs 10–13): the interior
+//! control points move to minimise `S = Σ δ_i²` towards a fixed `ρ̂`, by Levenberg–Marquardt on the
+//! banded normal equations (`docs/algorithms/kuragano.md`, "Shape modification").
 
 use serde::Serialize;
 
@@ -13,11 +13,11 @@ use crate::geom::Point;
 use crate::numeric::SymBanded;
 use crate::spline::{BSplineCurve, MAX_ORDER};
 
-/// Initial Levenberg–Marquardt damping (spec §5.5).
+/// Initial Levenberg–Marquardt damping (docs/algorithms/kuragano.md §5.5).
 pub(super) const MU_INITIAL: f64 = 1e-3;
 
 /// Factor by which μ is divided after an accepted step and multiplied after a rejected one
-/// (spec §5.5).
+/// (docs/algorithms/kuragano.md §5.5).
 pub(super) const MU_FACTOR: f64 = 10.0;
 
 /// Damping beyond which no step is deemed acceptable and the iteration stops: the step is
@@ -31,7 +31,7 @@ pub(crate) const DEFAULT_MAX_ITERATIONS: usize = 60;
 pub(super) const DIAG_FLOOR_REL: f64 = 1e-12;
 
 /// ρ at parameter `u` of a non-rational B-spline and its gradient with respect to the control
-/// points of the span, holding `u` fixed (spec §5.5):
+/// points of the span, holding `u` fixed (docs/algorithms/kuragano.md §5.5):
 ///
 /// ```text
 /// ∂ρ/∂q_r^x = 3 W^{1/2} x' N'_r / K − W^{3/2} (N'_r y'' − y' N''_r) / K²
@@ -187,8 +187,8 @@ fn resample(curve: &BSplineCurve, like: &RhoSamples) -> Result<RhoSamples> {
 }
 
 /// Modify the shape of `curve` so that its ρ at the fractions `start.s` approaches `target`
-/// (`ρ̂_i`, fixed), by Levenberg–Marquardt (spec §5.5; see the module docs). `start` are the
-/// samples of `curve` itself (from [`sample_rho`]), which fix `N_s`, `ρ_max` and σ.
+/// (`ρ̂_i`, fixed), by Levenberg–Marquardt (docs/algorithms/kuragano.md §5.5; see the module docs).
+/// `start` are the samples of `curve` itself (from [`sample_rho`]), which fix `N_s`, `ρ_max` and σ.
 ///
 /// # Errors
 /// [`Error::LengthMismatch`] when `target` and `start` differ in length,

@@ -15,7 +15,7 @@ use crate::error::{Error, Result};
 /// [`quintic::DEFAULT_GRADIENT_FRACTION`]: crate::spline::quintic::DEFAULT_GRADIENT_FRACTION
 pub const DEFAULT_METHOD_GRADIENT_FRACTION: f64 = 1.0;
 
-/// Which residual the shape modification minimises (spec §5.5).
+/// Which residual the shape modification minimises (docs/algorithms/kuragano.md §5.5).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 #[non_exhaustive]

@@ -1,6 +1,6 @@
-//! ρ sampled at equally spaced fractions of the normalised arc length (spec §5.4 steps 1–2:
-//! arc length by Gauss–Legendre, Newton inversion), with the orientation, the cap `ρ_max` and
-//! the inflection test; and the closed-form derivatives of the uniform quintic that the
+//! ρ sampled at equally spaced fractions of the normalised arc length (docs/algorithms/kuragano.md
+//! §5.4 steps 1–2: arc length by Gauss–Legendre, Newton inversion), with the orientation, the cap
+//! `ρ_max` and the inflection test; and the closed-form derivatives of the uniform quintic that the
 //! sampler and the shape modification evaluate (`docs/algorithms/kuragano.md`, "Curvature and ρ",
 //! "Radius-of-curvature specification").
 
@@ -14,10 +14,11 @@ use crate::numeric::GaussLegendre;
 use crate::spline::quintic;
 use crate::spline::{BSplineCurve, MAX_ORDER};
 
-/// Default number of ρ samples `N_s` (spec §5.4 and the test vectors).
+/// Default number of ρ samples `N_s` (docs/algorithms/kuragano.md §5.4 and the test vectors).
 pub(super) const DEFAULT_SAMPLES: usize = 41;
 
-/// Samples per segment in the automatic `N_s` (spec §5.4: "about 10 per segment").
+/// Samples per segment in the automatic `N_s` (docs/algorithms/kuragano.md §5.4: "about 10 per
+/// segment").
 pub(super) const SAMPLES_PER_SEGMENT: usize = 10;
 
 /// Fewest samples accepted: a degree-6 fit needs seven.
@@ -38,7 +39,8 @@ pub(super) fn default_samples(segments: usize) -> usize {
     DEFAULT_SAMPLES.max(SAMPLES_PER_SEGMENT * segments + 1)
 }
 
-/// ρ sampled at equally spaced fractions of the normalised arc length (spec §5.4 steps 1–2).
+/// ρ sampled at equally spaced fractions of the normalised arc length (docs/algorithms/kuragano.md
+/// §5.4 steps 1–2).
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct RhoSamples {
     /// The fractions `s_i = i/(N_s − 1)`.
@@ -85,8 +87,9 @@ impl RhoSamples {
     }
 }
 
-/// Sample ρ at `n_samples` equally spaced normalised arc-length fractions (spec §5.4 steps
-/// 1–2). `rho_max: None` caps at [`DEFAULT_RHO_MAX_REL`] times the length.
+/// Sample ρ at `n_samples` equally spaced normalised arc-length fractions
+/// (docs/algorithms/kuragano.md §5.4 steps 1–2). `rho_max: None` caps at [`DEFAULT_RHO_MAX_REL`]
+/// times the length.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for fewer than two samples or a bad `rho_max`,
@@ -119,9 +122,9 @@ pub(super) fn sample_rho(
 
 /// Arc length, parameters and curvature at the fractions; `rho` etc. left for the caller.
 ///
-/// Arc length by Gauss–Legendre on every span (spec §0.5); each `s_i·L` is inverted by
-/// Newton's method on `s(u) − s_i·L` inside its span, safeguarded by bisection, with the
-/// integral continued from the previous iterate. The samples are increasing, so the spans are
+/// Arc length by Gauss–Legendre on every span (docs/algorithms/README.md §0.5); each `s_i·L` is
+/// inverted by Newton's method on `s(u) − s_i·L` inside its span, safeguarded by bisection, with
+/// the integral continued from the previous iterate. The samples are increasing, so the spans are
 /// visited once: O(spans + N_s) evaluations of the closed-form basis.
 pub(super) fn sample_at_fractions(curve: &BSplineCurve, n_samples: usize) -> Result<RhoSamples> {
     let ev = Evaluator::new(curve);

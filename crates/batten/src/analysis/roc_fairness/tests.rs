@@ -1,7 +1,7 @@
-//! Kuragano & Yamaguchi (spec §5): the uniform quintic, the radius-of-curvature
-//! specification, the shape modification, the fairness evaluation and the `kuragano` method,
-//! against the "kuragano" vectors of `tests/data/test-vectors.json` (format: spec §7) and the
-//! properties the spec states.
+//! Kuragano & Yamaguchi (docs/algorithms/kuragano.md §5): the uniform quintic, the
+//! radius-of-curvature specification, the shape modification, the fairness evaluation and the
+//! `kuragano` method, against the "kuragano" vectors of `tests/data/test-vectors.json` (format:
+//! docs/algorithms/README.md §7) and the properties the spec states.
 //!
 //! Unit tests (formerly `tests/kuragano.rs`): they reach the specification's steps
 //! ([`sample_rho`], [`RhoFit`], [`modify_shape`], [`rho_gradient`]), which are not public.
@@ -499,8 +499,8 @@ fn method_rejects_bad_parameters() {
 
 #[test]
 fn natural_ends_design_option() {
-    // With natural ends ρ is infinite at both ends (spec §5.3): those samples are capped at
-    // σ·ρ_max and count as straight, not as inflections.
+    // With natural ends ρ is infinite at both ends (docs/algorithms/kuragano.md §5.3): those
+    // samples are capped at σ·ρ_max and count as straight, not as inflections.
     let (pts, _) = log_spiral(20, 0.2, 4.0);
     let c = quintic::interpolate(&pts, &Ends::Natural, QuinticForm::BSpline).expect("curve");
     let s = sample_rho(&c, 41, None).expect("samples");

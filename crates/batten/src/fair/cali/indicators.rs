@@ -1,7 +1,8 @@
-//! Calì's fairness indicators (spec §4.4: κ and arc length at the correspondence points, LFI,
-//! GFI) of a clamped B-spline, kept up to date under the local λ-moves of spec §4.5 in time
-//! independent of the number of control points, and the golden-section search for λ
-//! (`docs/algorithms/cali.md`, "Fairness indicators" and "The algorithm").
+//! Calì's fairness indicators (docs/algorithms/cali.md §4.4: κ and arc length at the correspondence
+//! points, LFI, GFI) of a clamped B-spline, kept up to date under the local λ-moves of
+//! docs/algorithms/cali.md §4.5 in time independent of the number of control points, and the
+//! golden-section search for λ (`docs/algorithms/cali.md`, "Fairness indicators" and "The
+//! algorithm").
 
 use crate::analysis::{fairness_indicators, signed_curvature};
 use crate::curve::Derivatives;
@@ -108,8 +109,9 @@ impl Trial {
     }
 }
 
-/// Calì's indicators (spec §4.4) of a clamped, non-rational B-spline, kept up to date under
-/// the local λ-moves of spec §4.5 in time independent of the number of control points.
+/// Calì's indicators (docs/algorithms/cali.md §4.4) of a clamped, non-rational B-spline, kept up to
+/// date under the local λ-moves of docs/algorithms/cali.md §4.5 in time independent of the number
+/// of control points.
 ///
 /// Holds the control points, κ at the correspondence points, the arc-length increments
 /// `h_j = s_j − s_{j−1}` (a move shifts every later `s_j` by a constant, which the divided
@@ -321,7 +323,7 @@ impl LocalIndicators {
     }
 
     /// `LFI_i` after the move centred at `i` with shape parameter λ: the objective of the
-    /// λ search (spec §4.5 step 3.3).
+    /// λ search (docs/algorithms/cali.md §4.5 step 3.3).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] for a centre outside [`LocalIndicators::candidates`] or
@@ -343,7 +345,7 @@ impl LocalIndicators {
     }
 
     /// The move centred at `i` with the λ that minimises `LFI_i(λ)` on [0, 1]: golden section
-    /// to `lambda_tol`, both end points compared (spec §4.5 \[CHOICE\]).
+    /// to `lambda_tol`, both end points compared (docs/algorithms/cali.md §4.5 \[CHOICE\]).
     ///
     /// # Errors
     /// As [`LocalIndicators::lfi_after`], and [`Error::InvalidParameter`] for a `lambda_tol`
@@ -554,7 +556,7 @@ impl LocalIndicators {
 }
 
 /// `κ''` at the middle of three curvature samples from the arc-length increments before and
-/// after it (spec §4.4): `2 [(κ_+ − κ_0)/h_+ − (κ_0 − κ_−)/h_−] / (h_− + h_+)`.
+/// after it (docs/algorithms/cali.md §4.4): `2 [(κ_+ − κ_0)/h_+ − (κ_0 − κ_−)/h_−] / (h_− + h_+)`.
 #[inline]
 fn second_difference(k: [f64; 3], h_minus: f64, h_plus: f64) -> f64 {
     2.0 * ((k[2] - k[1]) / h_plus - (k[1] - k[0]) / h_minus) / (h_minus + h_plus)

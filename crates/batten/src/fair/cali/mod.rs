@@ -1,22 +1,23 @@
 //! `cali`: local fairing with the integral λ-spline operator, after Calì, Miglio, Moroni and
 //! Rasella, *Curve fairing using integral spline operators*
 //! (`../shared/papers/cali-integral-spline-operators.txt`, §4, Steps 1–5), as specified in
-//! spec §4.3–4.5 (`../shared/spec/ALGORITHMS.md`).
+//! docs/algorithms/cali.md §4.3–4.5 (`../shared/spec/ALGORITHMS.md`).
 //!
 //! # The algorithm
 //!
-//! 1. Interpolate the points `Q_0..Q_n` by a clamped degree-p B-spline (spec §4.3 \[CHOICE\]:
-//!    chord-length parameters normalised to [0, 1], averaging knots; [`BSplineCurve::interpolate`]),
-//!    so there are m + 1 = n + 1 control points.
-//! 2. Compute the indicators of spec §4.4 \[CHOICE\]: the signed curvature `κ_j` and arc length
-//!    `s_j` at the correspondence points `ξ_j`, `LFI_j = (κ''_j)²` from the second divided
-//!    difference of κ with respect to s (j = 1..m−1), `GFI = Σ LFI_j`
+//! 1. Interpolate the points `Q_0..Q_n` by a clamped degree-p B-spline (docs/algorithms/cali.md
+//!    §4.3 \[CHOICE\]: chord-length parameters normalised to [0, 1], averaging knots;
+//!    [`BSplineCurve::interpolate`]), so there are m + 1 = n + 1 control points.
+//! 2. Compute the indicators of docs/algorithms/cali.md §4.4 \[CHOICE\]: the signed curvature
+//!    `κ_j` and arc length `s_j` at the correspondence points `ξ_j`, `LFI_j = (κ''_j)²` from the
+//!    second divided difference of κ with respect to s (j = 1..m−1), `GFI = Σ LFI_j`
 //!    ([`crate::analysis::fairness_indicators`]).
 //! 3. Take the candidates i = 2..m−2 in order of descending `LFI_i`. For each, move the five
-//!    control points `P_{i−2..i+2}` to `(M^λ P)_j` ([`LambdaOperator`], spec §4.2, with the
-//!    γ_0/α_m fix), λ minimising `LFI_i(λ)` on [0, 1] by a golden section to `lambda_tol`
-//!    with both end points compared (spec §4.5 \[CHOICE\]). `P_0` and `P_m` are never changed
-//!    (spec §4.5 \[CHOICE\]), so the curve keeps its end points.
+//!    control points `P_{i−2..i+2}` to `(M^λ P)_j` ([`LambdaOperator`], docs/algorithms/cali.md
+//!    §4.2, with the γ_0/α_m fix), λ minimising `LFI_i(λ)` on [0, 1] by a golden section to
+//!    `lambda_tol` with both end points compared (docs/algorithms/cali.md §4.5 \[CHOICE\]). `P_0`
+//!    and `P_m` are never changed (docs/algorithms/cali.md §4.5 \[CHOICE\]), so the curve keeps its
+//!    end points.
 //! 4. Accept the first candidate with `GFI_new < τ·GFI` (τ = 0.99 \[PAPER\]) and go back to 2;
 //!    the knots are never changed and the curve is not re-interpolated.
 //! 5. Stop when no candidate is accepted (the paper's "if i is the last point the procedure is
@@ -26,9 +27,9 @@
 //!
 //! The paper leaves the interpolation, the place where κ'' is evaluated and the λ search open;
 //! the spec's normative choices above are used. Its printed operator has two errors (γ_0
-//! missing, last matrix row), fixed as in spec §4.2; its strophoid numbers (GFI 75 → 10,
-//! "analytic max |κ| ≈ 0.7") are not reproducible from eq 30 as printed (spec §4.6) and are
-//! not asserted anywhere.
+//! missing, last matrix row), fixed as in docs/algorithms/cali.md §4.2; its strophoid numbers (GFI
+//! 75 → 10, "analytic max |κ| ≈ 0.7") are not reproducible from eq 30 as printed
+//! (docs/algorithms/cali.md §4.6) and are not asserted anywhere.
 //!
 //! # Common options
 //!
@@ -94,8 +95,8 @@
 //! # Files
 //!
 //! - this file: the method and its parameters;
-//! - `run.rs`: the driver of spec §4.5 (candidates in LFI order, the tolerance check, the
-//!   cache of candidate results, the output points and the report);
+//! - `run.rs`: the driver of docs/algorithms/cali.md §4.5 (candidates in LFI order, the tolerance
+//!   check, the cache of candidate results, the output points and the report);
 //! - `indicators.rs`: [`LocalIndicators`], the indicators kept up to date under local moves.
 //!
 //! `docs/algorithms/cali.md` gives the formulas with the paper's equation numbers and maps the
@@ -116,10 +117,12 @@ use crate::spline::MAX_ORDER;
 pub use indicators::{LocalIndicators, Trial};
 use run::{Settings, run_cali};
 
-/// The relaxation factor τ of the acceptance test `GFI_new < τ·GFI` (paper §5, spec §4.5).
+/// The relaxation factor τ of the acceptance test `GFI_new < τ·GFI` (paper §5,
+/// docs/algorithms/cali.md §4.5).
 pub(super) const DEFAULT_TAU: f64 = 0.99;
 
-/// Default absolute tolerance in λ of the golden-section search (spec §4.5 \[CHOICE\]).
+/// Default absolute tolerance in λ of the golden-section search (docs/algorithms/cali.md §4.5
+/// \[CHOICE\]).
 pub(super) const DEFAULT_LAMBDA_TOL: f64 = 1e-6;
 
 /// Default spline degree: cubic, as in the paper's tests.

@@ -1,5 +1,5 @@
-//! The driver of `cali` (spec §4.5, the paper's Steps 1–5): interpolate, then try the
-//! candidates in descending LFI order and accept the first whose move lowers the GFI below
+//! The driver of `cali` (docs/algorithms/cali.md §4.5, the paper's Steps 1–5): interpolate, then
+//! try the candidates in descending LFI order and accept the first whose move lowers the GFI below
 //! τ·GFI within the tolerance, until none does (`docs/algorithms/cali.md`, "The algorithm").
 
 use std::cmp::Reverse;

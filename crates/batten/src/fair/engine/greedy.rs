@@ -1,8 +1,8 @@
 //! The greedy move engine: move the worst slot (a point or a knot) until every badness is at
 //! most ε, the move limit is reached, or no bad slot can move within the tolerance; the
 //! max-tree that keeps the worst slot, the stopping threshold ε and the move limit
-//! (`docs/algorithms/kjellander-poliakoff.md`, "The algorithm", spec §2.6, and "What
-//! `sapidis-farin` borrows").
+//! (`docs/algorithms/kjellander-poliakoff.md`, "The algorithm",
+//! docs/algorithms/kjellander-poliakoff.md §2.6, and "What `sapidis-farin` borrows").
 
 use serde_json::{Map, Value, json};
 
@@ -228,8 +228,8 @@ fn checked_badness(p: &impl LocalProblem, i: usize) -> Result<f64> {
     }
 }
 
-/// The greedy loop of spec §2.6: move the worst slot until every badness is at most ε, the
-/// move limit is reached, or no bad slot can move within the tolerance.
+/// The greedy loop of docs/algorithms/kjellander-poliakoff.md §2.6: move the worst slot until every
+/// badness is at most ε, the move limit is reached, or no bad slot can move within the tolerance.
 pub(crate) fn drive(
     p: &mut impl LocalProblem,
     threshold: Threshold,

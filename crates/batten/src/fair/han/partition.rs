@@ -41,7 +41,7 @@ pub(super) fn chord_angles(points: &[Point]) -> Result<Vec<f64>> {
         .collect()
 }
 
-/// Unwrapped turning angles (spec §1.8 step 2, \[FIX\]): `α_0 = 0`,
+/// Unwrapped turning angles (docs/algorithms/han.md §1.8 step 2, \[FIX\]): `α_0 = 0`,
 /// `α_i = α_{i−1} + wrap(φ_i − φ_{i−1})` with wrap into (−π, π]; one per chord. `α_{N−2}` is
 /// the total turning of the polyline.
 ///
@@ -75,8 +75,8 @@ fn wrap_angle(a: f64) -> f64 {
     }
 }
 
-/// Split a point sequence into overlapping function segments (spec §1.8 step 3): from b, the
-/// first chord s whose inclusion makes `max α − min α > max_turn` ends the segment at
+/// Split a point sequence into overlapping function segments (docs/algorithms/han.md §1.8 step 3):
+/// from b, the first chord s whose inclusion makes `max α − min α > max_turn` ends the segment at
 /// `P_{s−1}` (0-based: points `b..=s−1`); segments have at least `overlap + 2` points (capped
 /// at the end); the next starts `overlap − 1` points before the end, so neighbours share
 /// `overlap` points. Each span carries its bisector frame angle (step 4).
@@ -127,7 +127,8 @@ pub(super) fn partition(points: &[Point], max_turn: f64, overlap: usize) -> Resu
     }
 }
 
-/// θ = φ_a + (α_u + α_l)/2 − α_a over the chords a..end−1 (spec §1.8 step 4, \[FIX\]).
+/// θ = φ_a + (α_u + α_l)/2 − α_a over the chords a..end−1 (docs/algorithms/han.md §1.8 step 4,
+/// \[FIX\]).
 fn frame_angle(phi: &[f64], alpha: &[f64], a: usize, end: usize) -> f64 {
     let chords = &alpha[a..end];
     let (hi, lo) = chords

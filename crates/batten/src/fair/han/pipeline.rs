@@ -20,12 +20,12 @@ use crate::geom::{Point, PointSeq, Vec2, max_abs_coordinate};
 pub(super) const MIN_FALLBACK_TURN: f64 = PI / 8.0;
 /// A segment with a chord steeper than this in its bisector frame (`|ΔY/ΔX|`, ≈ 89.4°) is
 /// re-partitioned with half the turning threshold, down to π/8, and left unfaired only past
-/// that (\[CHOICE\] guard). The function-spline proxy assumes moderate slopes (spec §1.8
-/// note: up to 76 seen on the strophoid with `max_turn = π`, faired with some drift). Steeper
-/// segments come from the minimum-length rule extending a segment round a tight loop until it
-/// turns by almost π; their spacing ratios reach 1e-6, the unit responses are huge and the
-/// moves diverge (we saw a point thrown 500 curve sizes away). With `max_turn = π/2` segments
-/// have slopes ≤ 1 unless extended.
+/// that (\[CHOICE\] guard). The function-spline proxy assumes moderate slopes
+/// (docs/algorithms/han.md §1.8 note: up to 76 seen on the strophoid with `max_turn = π`, faired
+/// with some drift). Steeper segments come from the minimum-length rule extending a segment round a
+/// tight loop until it turns by almost π; their spacing ratios reach 1e-6, the unit responses are
+/// huge and the moves diverge (we saw a point thrown 500 curve sizes away). With `max_turn = π/2`
+/// segments have slopes ≤ 1 unless extended.
 pub(super) const MAX_LOCAL_SLOPE: f64 = 100.0;
 /// At most this many moves are listed in the report; later moves are counted, not listed.
 pub(super) const MAX_RECORDED_MOVES: usize = 10_000;
@@ -188,7 +188,8 @@ fn open_pass(
         let (faired, m, sub_log) = result?;
         log.append(sub_log);
         moves += m;
-        // Blend the points shared with what is already there (spec §1.8.6): w_q = q/(K+1).
+        // Blend the points shared with what is already there (docs/algorithms/han.md §1.8.6): w_q =
+        // q/(K+1).
         let shared = covered_to.map_or(0, |c| (c + 1).saturating_sub(span.start));
         for (q, p) in faired.iter().enumerate() {
             let idx = span.start + q;

@@ -1,6 +1,6 @@
 //! HAN's unit spline responses `c̃_i^j` and the exact update of c after a move, in O(n)
 //! storage (eqs 13–17 with the end fix; `docs/algorithms/han.md`, "Unit spline responses",
-//! spec §1.6). The costs are in the module docs of `han`.
+//! docs/algorithms/han.md §1.6). The costs are in the module docs of `han`.
 
 use super::sign::abs_max;
 use crate::error::{Error, Result};
@@ -11,8 +11,9 @@ use crate::spline::{CubicSplineFn, FnEndCondition};
 /// update equals eq 13 to rounding.
 pub(super) const RESPONSE_CUTOFF_REL: f64 = 1e-17;
 
-/// HAN's unit spline responses `c̃_i^j` (spec §1.6, eqs 14–17 with the end fix) and the
-/// derived `ẽ_i^j`, for the end condition `c_1 = c_2`, `c_{n−1} = c_n`. They depend on x only.
+/// HAN's unit spline responses `c̃_i^j` (docs/algorithms/han.md §1.6, eqs 14–17 with the end fix)
+/// and the derived `ẽ_i^j`, for the end condition `c_1 = c_2`, `c_{n−1} = c_n`. They depend on x
+/// only.
 ///
 /// Storage is O(n): `c̃_{j−1}^j, c̃_j^j, c̃_{j+1}^j` for each interior j plus the sweep
 /// coefficients; farther entries come from `c̃_i^j = −a_i c̃_{i+1}^j` (i ≤ j−2) and
@@ -152,7 +153,7 @@ impl UnitResponses {
     }
 
     /// `ẽ_i^j = (c̃_{i+1}^j − c̃_i^j)/h_i − (c̃_i^j − c̃_{i−1}^j)/h_{i−1}`, 0 at the end points
-    /// (spec §1.6). O(|i − j|).
+    /// (docs/algorithms/han.md §1.6). O(|i − j|).
     ///
     /// # Panics
     /// As [`UnitResponses::c`].

@@ -1,7 +1,7 @@
 //! One function segment `(x_i, y_i)` being faired by HAN's two phases: its parameters, the
 //! moves and their tags, the bounds and the exact update of c and e after every move
-//! (`docs/algorithms/han.md`, "Fairing one function segment", spec §1.7). The cases
-//! themselves are in `segment/cases.rs`.
+//! (`docs/algorithms/han.md`, "Fairing one function segment", docs/algorithms/han.md §1.7). The
+//! cases themselves are in `segment/cases.rs`.
 
 mod cases;
 
@@ -14,7 +14,7 @@ use crate::error::{Error, Result};
 use crate::geom::Point;
 use crate::spline::{CubicSplineFn, FnEndCondition};
 
-/// The fewest points a function segment must have to be faired (spec §1.7).
+/// The fewest points a function segment must have to be faired (docs/algorithms/han.md §1.7).
 pub(super) const MIN_SEGMENT_POINTS: usize = 5;
 /// Rounding-noise floor of the sign tests \[CHOICE\]. Rounding the coordinates (magnitude R) to
 /// double precision puts noise of up to about `0.4·ε·R/h²` into c and `4·0.4·ε·R/h³` into e
@@ -229,11 +229,12 @@ impl Procedure {
     ];
 }
 
-/// A function segment `(x_i, y_i)`, i = 1..n, being faired by HAN's two phases (spec §1.7).
+/// A function segment `(x_i, y_i)`, i = 1..n, being faired by HAN's two phases
+/// (docs/algorithms/han.md §1.7).
 ///
 /// It holds y, the spline coefficients c, the indicator e and the unit responses, and keeps
-/// c and e exact after every move (eq 13, see `docs/algorithms/han.md`). Only `y_2..y_{n−1}` move; the
-/// x values and the end values never change. Indices are 0-based (point k is the paper's
+/// c and e exact after every move (eq 13, see `docs/algorithms/han.md`). Only `y_2..y_{n−1}` move;
+/// the x values and the end values never change. Indices are 0-based (point k is the paper's
 /// k + 1).
 ///
 /// ```
@@ -539,8 +540,8 @@ impl Segment {
             .map_or(0.0, |(scale, _)| scale))
     }
 
-    /// Coarse case 1 (small vibration, spec §1.7.1): for i = 2..n−2 (1-based) with
-    /// `e_i e_{i+1} < 0`, move `y_i += λ_c σ`, `y_{i+1} −= λ_c σ` with σ the smaller root of
+    /// Coarse case 1 (small vibration, docs/algorithms/han.md §1.7.1): for i = 2..n−2 (1-based)
+    /// with `e_i e_{i+1} < 0`, move `y_i += λ_c σ`, `y_{i+1} −= λ_c σ` with σ the smaller root of
     /// `ẽ_i ẽ_{i+1} = 0`. Returns the moves.
     pub fn coarse_case1(&mut self) -> Vec<CaseMove> {
         self.collect(Procedure::CoarseCase1)

@@ -1,13 +1,13 @@
-//! The sign tests of HAN's cases, `sgn0` with the relative zero of spec §1.7.0 and the
-//! rounding-noise floors, kept exact under local updates (`docs/algorithms/han.md`, "Sign
+//! The sign tests of HAN's cases, `sgn0` with the relative zero of docs/algorithms/han.md §1.7.0
+//! and the rounding-noise floors, kept exact under local updates (`docs/algorithms/han.md`, "Sign
 //! tests").
 
 use super::responses::Changed;
 use crate::analysis::{ZERO_REL, sgn0};
 
-/// `sgn0(v, max_k |v_k|)` (spec §1.7.0) for an array under local updates, without keeping the
-/// maximum itself exact: an upper bound (raised by every written value) and a lower bound (the
-/// magnitude of one tracked entry) decide almost every test; only a value between
+/// `sgn0(v, max_k |v_k|)` (docs/algorithms/han.md §1.7.0) for an array under local updates, without
+/// keeping the maximum itself exact: an upper bound (raised by every written value) and a lower
+/// bound (the magnitude of one tracked entry) decide almost every test; only a value between
 /// `ZERO_REL·lower` and `ZERO_REL·upper` needs the exact maximum, which is then rescanned and
 /// both bounds are reset to it. The result is the same as with the exact maximum.
 #[derive(Clone, Debug)]

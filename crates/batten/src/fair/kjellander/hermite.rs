@@ -88,12 +88,12 @@ impl LocalProblem for HermiteState {
 /// The method parameters [`fair_hermite`] accepts.
 pub(super) const HERMITE_PARAMS: &[ParamSpec] = &JUMP_PARAMS;
 
-/// Fair Hermite data `(t, points, tangents)` by `rule` (spec §2.6 without re-interpolation):
-/// the bad point is the interior point with the largest `|J_k|` of the C¹ Hermite curve, it
-/// moves (and, for [`KpRule::Energy`], its tangent changes by `η*`), the parameters and all
-/// other data are kept, and only the jumps at `k−1, k, k+1` change. Stopping, tolerance and
-/// the report are as for the point methods ([`Kjellander`](super::Kjellander)); the method
-/// parameters are
+/// Fair Hermite data `(t, points, tangents)` by `rule` (docs/algorithms/kjellander-poliakoff.md
+/// §2.6 without re-interpolation): the bad point is the interior point with the largest `|J_k|` of
+/// the C¹ Hermite curve, it moves (and, for [`KpRule::Energy`], its tangent changes by `η*`), the
+/// parameters and all other data are kept, and only the jumps at `k−1, k, k+1` change. Stopping,
+/// tolerance and the report are as for the point methods ([`Kjellander`](super::Kjellander)); the
+/// method parameters are
 /// `threshold` and `epsilon`.
 ///
 /// Returns an [`Outcome`] with the moved points and `tangents: Some(..)`.

@@ -4,25 +4,29 @@
 //!
 //! Paper: *Improved fairing of non-uniform parametric cubic splines* (Kjellander → Poliakoff →
 //! position + tangent), `../shared/papers/kjellander-poliakoff-improved.txt`. The equations
-//! are the reconstructed forms of spec §2 (`../shared/spec/ALGORITHMS.md`); nearly every
-//! printed equation is damaged by OCR (spec §2.8):
+//! are the reconstructed forms of docs/algorithms/kjellander-poliakoff.md §2
+//! (`../shared/spec/ALGORITHMS.md`); nearly every printed equation is damaged by OCR
+//! (docs/algorithms/kjellander-poliakoff.md §2.8):
 //!
 //! - the third-derivative jump `J_k = r'''(t_k+) − r'''(t_k−) = 6(a_{k,3} − a_{k−1,3})` of the
-//!   Hermite coefficients of KP eq 6 (spec §2.2);
+//!   Hermite coefficients of KP eq 6 (docs/algorithms/kjellander-poliakoff.md §2.2);
 //! - **Kjellander** (eq 4, uniform parameters): `r_k,new = (r_{k−1} + r_{k+1})/2 +
-//!   (r'_{k−1} − r'_{k+1})/4` — the printed equation is unreadable, spec §2.8 gives this form;
+//!   (r'_{k−1} − r'_{k+1})/4` — the printed equation is unreadable,
+//!   docs/algorithms/kjellander-poliakoff.md §2.8 gives this form;
 //! - **Poliakoff** (eq 8, any parameters, `A = Δ_{k−1}`, `B = Δ_k`): the position that makes
-//!   `J_k = 0` with every tangent kept (spec §2.3);
-//! - **energy** (eqs 11–12 as **fixed** in spec §2.5): the change `(δ*, η*)` of position and
-//!   tangent that minimises the exact energy change `W' − W = 4C·F(δ, η)` of Lemma 1 (eq 14,
-//!   with the coefficient repairs of spec §2.8). With `η = 0` the minimiser is
-//!   `δ = J3/(2/A³ + 2/B³)`, which is Poliakoff's eq 8 (the corollary): that is the
-//!   `mode = position` of the `energy` method and [`KpRule::EnergyPositionOnly`].
+//!   `J_k = 0` with every tangent kept (docs/algorithms/kjellander-poliakoff.md §2.3);
+//! - **energy** (eqs 11–12 as **fixed** in docs/algorithms/kjellander-poliakoff.md §2.5): the
+//!   change `(δ*, η*)` of position and tangent that minimises the exact energy change `W' − W =
+//!   4C·F(δ, η)` of Lemma 1 (eq 14, with the coefficient repairs of
+//!   docs/algorithms/kjellander-poliakoff.md §2.8). With `η = 0` the minimiser is `δ = J3/(2/A³ +
+//!   2/B³)`, which is Poliakoff's eq 8 (the corollary): that is the `mode = position` of the
+//!   `energy` method and [`KpRule::EnergyPositionOnly`].
 //!
-//! # The algorithm (spec §2.6)
+//! # The algorithm (docs/algorithms/kjellander-poliakoff.md §2.6)
 //!
-//! 1. Interpolate the points with the C² cubic spline with natural ends (spec §2.1):
-//!    chord-length parameters for `poliakoff` and `energy`, uniform `t_i = i` for `kjellander`.
+//! 1. Interpolate the points with the C² cubic spline with natural ends
+//!    (docs/algorithms/kjellander-poliakoff.md §2.1): chord-length parameters for `poliakoff`
+//!    and `energy`, uniform `t_i = i` for `kjellander`.
 //!    Closed curves use the periodic spline (as [`ParametricCubic::closed`]): every point is
 //!    then interior.
 //! 2. The bad point is the interior point with the largest `|J_k|` (Euclidean norm).
@@ -32,10 +36,11 @@
 //!    own jumps is independent of the data's scale and parametrisation.
 //! 4. Move the bad point by its rule. Point-only fairing applies the position only: the
 //!    `energy` method applies `δ*` and discards `η*` (as the paper does in its examples,
-//!    spec §2.6 step 4), since re-interpolation recomputes every tangent.
+//!    docs/algorithms/kjellander-poliakoff.md §2.6 step 4), since re-interpolation recomputes every
+//!    tangent.
 //! 5. Re-interpolate, recomputing the chord-length parameters from the moved points (the
-//!    \[CHOICE\] of spec §2.6 step 5; method parameter `reparametrize = false` keeps the
-//!    input's parameters instead). Repeat from 2.
+//!    \[CHOICE\] of docs/algorithms/kjellander-poliakoff.md §2.6 step 5; method parameter
+//!    `reparametrize = false` keeps the input's parameters instead). Repeat from 2.
 //!
 //! With the parameters kept (`kjellander` always, the others with `reparametrize = false`)
 //! no move increases `∫|r''|² dt`: the natural (or periodic) spline has the least energy of
@@ -94,7 +99,8 @@
 //!
 //! # Files
 //!
-//! - `rules.rs`: the jump and the three rules at one point (spec §2.2–§2.5);
+//! - `rules.rs`: the jump and the three rules at one point (docs/algorithms/kjellander-poliakoff.md
+//!   §2.2–§2.5);
 //! - `params.rs`: the `--set` tables beyond ε;
 //! - `points.rs`: point-only fairing of a point sequence (windowed re-solves);
 //! - `hermite.rs`: fairing of Hermite data;
@@ -132,8 +138,8 @@ pub struct Kjellander;
 pub struct Poliakoff;
 
 /// Method `energy`: chord-length parametric cubic, the bad point moved by the energy-optimal
-/// `δ*` of eqs 11–12 (spec §2.5), or by the position-only optimum with `mode = position`
-/// (see `docs/algorithms/kjellander-poliakoff.md`).
+/// `δ*` of eqs 11–12 (docs/algorithms/kjellander-poliakoff.md §2.5), or by the position-only
+/// optimum with `mode = position` (see `docs/algorithms/kjellander-poliakoff.md`).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Energy;
 

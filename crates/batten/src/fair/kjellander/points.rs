@@ -1,7 +1,8 @@
 //! Point-only fairing of a [`PointSeq`] by the KP rules: the C² interpolating cubic (natural
 //! or periodic) of the current points, kept up to date by windowed re-solves of its tangents
 //! after every move (`docs/algorithms/kjellander-poliakoff.md`, "The interpolating spline" and
-//! "The algorithm", spec §2.1 and §2.6; the cost is in the module docs of `kjellander`).
+//! "The algorithm", docs/algorithms/kjellander-poliakoff.md §2.1 and §2.6; the cost is in the
+//! module docs of `kjellander`).
 
 use serde_json::json;
 
@@ -115,10 +116,10 @@ impl SplineState {
         }
     }
 
-    /// Row `i` of the interpolation system (spec §2.1): `(sub, diag, sup, rhs)`. The end
-    /// rows `2·m₀ + m₁ = 3·(r₁ − r₀)/Δt₀` are multiplied by `Δt₀` so that every row is in
-    /// the same units (lengths, on the chord-length spline): otherwise, at coordinates of
-    /// 10¹⁴, the end pivots 2 would be below the solver's relative zero next to the
+    /// Row `i` of the interpolation system (docs/algorithms/kjellander-poliakoff.md §2.1): `(sub,
+    /// diag, sup, rhs)`. The end rows `2·m₀ + m₁ = 3·(r₁ − r₀)/Δt₀` are multiplied by `Δt₀` so that
+    /// every row is in the same units (lengths, on the chord-length spline): otherwise, at
+    /// coordinates of 10¹⁴, the end pivots 2 would be below the solver's relative zero next to the
     /// interior ones `2·(Δt_{i−1} + Δt_i)`.
     fn row(&self, i: usize) -> (f64, f64, f64, Vec2) {
         let n = self.n();

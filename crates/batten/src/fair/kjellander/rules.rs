@@ -1,9 +1,9 @@
 //! The Kjellander–Poliakoff rules at one interior point of Hermite data: the third-derivative
 //! jump `J_k`, the moves of Kjellander (eq 4), Poliakoff (eq 8) and the energy-optimal change
-//! of position and tangent (eqs 11–12 as fixed in spec §2.5), and the energy change of Lemma 1
-//! (eq 14) (`docs/algorithms/kjellander-poliakoff.md`, "The third-derivative jump and
-//! Kjellander", "Poliakoff", "The energy-optimal change of position and tangent"; spec
-//! §2.2–§2.5).
+//! of position and tangent (eqs 11–12 as fixed in docs/algorithms/kjellander-poliakoff.md §2.5),
+//! and the energy change of Lemma 1 (eq 14) (`docs/algorithms/kjellander-poliakoff.md`, "The
+//! third-derivative jump and Kjellander", "Poliakoff", "The energy-optimal change of position and
+//! tangent", §2.2–§2.5).
 
 use crate::error::{Error, Result};
 use crate::fair::engine::JUMP_ZERO_REL;
@@ -14,7 +14,7 @@ use crate::spline::ParametricCubic;
 /// of 1 count as unit steps.
 pub(super) const UNIT_STEP_REL: f64 = 1e-9;
 
-/// The update rule for the bad point (spec §2.2–2.5).
+/// The update rule for the bad point (docs/algorithms/kjellander-poliakoff.md §2.2–2.5).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum KpRule {
@@ -22,10 +22,12 @@ pub enum KpRule {
     Kjellander,
     /// Poliakoff, eq 8: the position that makes `J_k = 0` with all tangents kept.
     Poliakoff,
-    /// The energy-optimal change of position and tangent, `(δ*, η*)` of eqs 11–12 (spec §2.5).
+    /// The energy-optimal change of position and tangent, `(δ*, η*)` of eqs 11–12
+    /// (docs/algorithms/kjellander-poliakoff.md §2.5).
     Energy,
-    /// The energy-optimal change of position alone (`η = 0`): the corollary of spec §2.5,
-    /// equal to Poliakoff's eq 8, computed from the energy quadratic.
+    /// The energy-optimal change of position alone (`η = 0`): the corollary of
+    /// docs/algorithms/kjellander-poliakoff.md §2.5, equal to Poliakoff's eq 8, computed from the
+    /// energy quadratic.
     EnergyPositionOnly,
 }
 
@@ -76,7 +78,7 @@ impl Local {
         )
     }
 
-    /// `J_k = 6(a_{k,3} − a_{k−1,3})` (spec §2.2).
+    /// `J_k = 6(a_{k,3} − a_{k−1,3})` (docs/algorithms/kjellander-poliakoff.md §2.2).
     pub(super) fn jump(&self) -> Vec2 {
         let ((_, a3p), (_, a3n)) = self.spans();
         (a3n - a3p) * 6.0
@@ -119,7 +121,7 @@ impl Local {
                 ((num / w).to_point() - self.r, Vec2::ZERO)
             }
             KpRule::Energy => {
-                // Eqs 11–12 as fixed in spec §2.5.
+                // Eqs 11–12 as fixed in docs/algorithms/kjellander-poliakoff.md §2.5.
                 let ((a2p, a3p), (a2n, a3n)) = self.spans();
                 let j3 = a3p - a3n;
                 let j2 = a2n - a2p - a3p * (3.0 * a);
@@ -131,7 +133,7 @@ impl Local {
                 (delta, eta)
             }
             KpRule::EnergyPositionOnly => {
-                // The corollary of spec §2.5: minimise F(δ, 0).
+                // The corollary of docs/algorithms/kjellander-poliakoff.md §2.5: minimise F(δ, 0).
                 let ((_, a3p), (_, a3n)) = self.spans();
                 let j3 = a3p - a3n;
                 (j3 / (2.0 / (a * a * a) + 2.0 / (b * b * b)), Vec2::ZERO)
@@ -139,7 +141,7 @@ impl Local {
         }
     }
 
-    /// `F(δ, η)` of Lemma 1 (eq 14, spec §2.5): `W' − W = 4C·F`.
+    /// `F(δ, η)` of Lemma 1 (eq 14, docs/algorithms/kjellander-poliakoff.md §2.5): `W' − W = 4C·F`.
     pub(super) fn energy_f(&self, delta: Vec2, eta: Vec2) -> f64 {
         let (a, b) = (self.a, self.b);
         let ((a2p, a3p), (a2n, a3n)) = self.spans();
@@ -224,11 +226,11 @@ pub(super) fn check_unit_steps(t: &[f64]) -> Result<()> {
 /// One move of the interior point `k` (0-based) of the Hermite data `(t, points, tangents)`
 /// by `rule`: the new position and tangent, the changes `δ`, `η` and the jump `J_k` before
 /// the move. Nothing else changes: the other points, all other tangents and the parameters
-/// are kept (the setting of spec §2.2–2.5).
+/// are kept (the setting of docs/algorithms/kjellander-poliakoff.md §2.2–2.5).
 ///
 /// Kjellander's and Poliakoff's rules keep the tangent (`η = 0`); [`KpRule::Energy`] returns
 /// `(δ*, η*)` of eqs 11–12. For tangents of a C² spline, `δ*` is Poliakoff's move scaled by
-/// `4(A³ + B³)/(A + B)³` (spec §2.5).
+/// `4(A³ + B³)/(A + B)³` (docs/algorithms/kjellander-poliakoff.md §2.5).
 ///
 /// # Errors
 /// [`Error::TooFewPoints`], [`Error::LengthMismatch`], [`Error::NonFinite`],
@@ -255,9 +257,9 @@ pub fn hermite_step(
     })
 }
 
-/// The quadratic `F(δ, η)` of Lemma 1 (eq 14, spec §2.5) at the interior point `k` (0-based)
-/// of Hermite data: changing `r_k` by `δ` and `r'_k` by `η`, all other data kept, changes the
-/// energy `∫|r''|² dt` by exactly `4F`.
+/// The quadratic `F(δ, η)` of Lemma 1 (eq 14, docs/algorithms/kjellander-poliakoff.md §2.5) at the
+/// interior point `k` (0-based) of Hermite data: changing `r_k` by `δ` and `r'_k` by `η`, all other
+/// data kept, changes the energy `∫|r''|² dt` by exactly `4F`.
 ///
 /// # Errors
 /// As [`hermite_step`].
@@ -272,8 +274,8 @@ pub fn energy_change_f(
     Ok(hermite_local(t, points, tangents, k)?.energy_f(delta, eta))
 }
 
-/// The parametric energy `∫|r''(t)|² dt` of a cubic spline (spec §0.4, the `W/C` of KP
-/// §2.5), in closed form span by span: `4|a2|²Δ + 12(a2·a3)Δ² + 12|a3|²Δ³`.
+/// The parametric energy `∫|r''(t)|² dt` of a cubic spline (docs/algorithms/README.md §0.4, the
+/// `W/C` of KP §2.5), in closed form span by span: `4|a2|²Δ + 12(a2·a3)Δ² + 12|a3|²Δ³`.
 pub fn parametric_energy(curve: &ParametricCubic) -> f64 {
     let t = curve.knots();
     (0..curve.num_spans())

@@ -9,11 +9,11 @@
 //! # The fairing method
 //!
 //! [`Kuragano`] fairs a point sequence: the quintic interpolant (ends: see
-//! [`DesignEnds`]; default natural ends would make ρ infinite at both ends, spec §5.3, so the
-//! default is [`DesignEnds::Gradients`] with estimated end gradients of magnitude
-//! [`DEFAULT_METHOD_GRADIENT_FRACTION`] of the end chord), the degree (`degree=d`, default:
-//! the best degree of [`evaluate`]), the shape modification, and the modified curve evaluated
-//! at the input points' parameters `u = 0, 1, …, m−1` (same count and order).
+//! [`DesignEnds`]; default natural ends would make ρ infinite at both ends,
+//! docs/algorithms/kuragano.md §5.3, so the default is [`DesignEnds::Gradients`] with estimated end
+//! gradients of magnitude [`DEFAULT_METHOD_GRADIENT_FRACTION`] of the end chord), the degree
+//! (`degree=d`, default: the best degree of [`evaluate`]), the shape modification, and the modified
+//! curve evaluated at the input points' parameters `u = 0, 1, …, m−1` (same count and order).
 //!
 //! - `--tolerance` is a hard bound: a trial step that would move any output point farther
 //!   than the tolerance from its input is rejected like a step that does not decrease S
@@ -29,9 +29,9 @@
 //!   RMS of `ρ_i − ρ̂_i` after the modification.
 //!
 //! Straight input, and input whose interpolant has an inflection, have no applicable degree
-//! (spec §5.4.4): with `degree=auto` the method returns the input unchanged (status
-//! `no_change`) with a note. **\[CHOICE\]** With an explicit `degree=d` and an inflected design
-//! (typically noise), ρ̂ is fitted to the samples where ρ is valid (finite, with the curve's
+//! (docs/algorithms/kuragano.md §5.4.4): with `degree=auto` the method returns the input unchanged
+//! (status `no_change`) with a note. **\[CHOICE\]** With an explicit `degree=d` and an inflected
+//! design (typically noise), ρ̂ is fitted to the samples where ρ is valid (finite, with the curve's
 //! orientation) and the shape modification, whose residual takes the curvature form at the
 //! inflected samples, removes the inflections; without inflections the explicit degree uses the
 //! spec's fit. A degree whose ρ̂ changes sign is an error.

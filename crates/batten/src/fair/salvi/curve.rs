@@ -1,8 +1,8 @@
-//! Salvi & Várady's curve algorithm (spec §3 steps 5–9): the control point of largest local
-//! deviation outside the recently-moved list, moved by downhill simplex within δ of its
-//! original, accepted when Ê decreases, until the window rule stops the run; every evaluation
-//! local to the support of the moved point (`docs/algorithms/salvi-varady.md`, "Candidate
-//! selection" to "Acceptance and stopping").
+//! Salvi & Várady's curve algorithm (docs/algorithms/salvi-varady.md §3 steps 5–9): the control
+//! point of largest local deviation outside the recently-moved list, moved by downhill simplex
+//! within δ of its original, accepted when Ê decreases, until the window rule stops the run; every
+//! evaluation local to the support of the moved point (`docs/algorithms/salvi-varady.md`,
+//! "Candidate selection" to "Acceptance and stopping").
 
 use std::ops::Range;
 
@@ -25,10 +25,10 @@ use crate::spline::{BSplineCurve, MAX_ORDER};
 pub(super) const STALL_REL_IMPROVEMENT: f64 = 1e-3;
 
 /// The simplex edge s is this fraction of the mean length of the control-polygon legs at the
-/// moved point (spec §3 step 6).
+/// moved point (docs/algorithms/salvi-varady.md §3 step 6).
 pub(super) const SIMPLEX_STEP_REL: f64 = 0.1;
 
-/// Simplex evaluation budget per move (spec §3 step 6).
+/// Simplex evaluation budget per move (docs/algorithms/salvi-varady.md §3 step 6).
 pub(super) const SIMPLEX_MAX_EVALUATIONS: usize = 400;
 
 /// What [`fair_curve`] did, with the sampled curvatures.
@@ -222,7 +222,8 @@ fn local_sum(contrib: &[f64], range: &Range<usize>) -> f64 {
     contrib[range.clone()].iter().sum()
 }
 
-/// The search of a run (spec §3 steps 5–9): the curve being faired and what changes with it.
+/// The search of a run (docs/algorithms/salvi-varady.md §3 steps 5–9): the curve being faired and
+/// what changes with it.
 struct Search {
     p: usize,
     /// δ.

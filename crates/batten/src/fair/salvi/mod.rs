@@ -78,9 +78,9 @@
 //! # Files
 //!
 //! - `params.rs`: [`SalviParams`], the `--set` table and its parsing;
-//! - `target.rs`: the samples, the curvature, the target g and the measure Ê (spec §3
-//!   steps 2–4);
-//! - `curve.rs`: [`fair_curve`], the search (spec §3 steps 5–9);
+//! - `target.rs`: the samples, the curvature, the target g and the measure Ê
+//!   (docs/algorithms/salvi-varady.md §3 steps 2–4);
+//! - `curve.rs`: [`fair_curve`], the search (docs/algorithms/salvi-varady.md §3 steps 5–9);
 //! - this file: the method on point or B-spline input and its report.
 //!
 //! `docs/algorithms/salvi-varady.md` gives the formulas with the paper's equation numbers and

@@ -67,8 +67,8 @@ pub struct SalviParams {
     pub held_ends: usize,
     /// Skip a control point whose last search made no progress (relative local improvement
     /// below `STALL_REL_IMPROVEMENT`) until a control point whose support overlaps its own
-    /// makes progress; stop when every movable point is skipped. `false` follows spec §3 step 5
-    /// literally (see the module documentation).
+    /// makes progress; stop when every movable point is skipped. `false` follows
+    /// docs/algorithms/salvi-varady.md §3 step 5 literally (see the module documentation).
     ///
     /// Default value: `true`.
     pub skip_stalled: bool,

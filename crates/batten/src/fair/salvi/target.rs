@@ -1,7 +1,8 @@
-//! The curvature samples of `salvi` and the target g made from them (spec §3 steps 2–4): the
-//! sample count, the signed curvature at the samples, the smoothers (moving average, a
-//! B-spline fit of κ(s), or given), the pinned ends, and the measure Ê of eq 14
-//! (`docs/algorithms/salvi-varady.md`, "Samples", "Target curvature", "The measure").
+//! The curvature samples of `salvi` and the target g made from them
+//! (docs/algorithms/salvi-varady.md §3 steps 2–4): the sample count, the signed curvature at the
+//! samples, the smoothers (moving average, a B-spline fit of κ(s), or given), the pinned ends, and
+//! the measure Ê of eq 14 (`docs/algorithms/salvi-varady.md`, "Samples", "Target curvature", "The
+//! measure").
 
 use crate::analysis::{ArcLengthTable, signed_curvature};
 use crate::curve::{CurveDeriv, Piecewise};
@@ -26,10 +27,11 @@ pub(super) const MIN_SAMPLES: usize = 4;
 /// `target_coefficients`, which are counts of samples.
 pub const MAX_SAMPLES: usize = 20_000;
 
-/// The moving-average half-width is `⌊N / HALF_WIDTH_DIVISOR⌋` (spec §3 step 3.2).
+/// The moving-average half-width is `⌊N / HALF_WIDTH_DIVISOR⌋` (docs/algorithms/salvi-varady.md §3
+/// step 3.2).
 pub(super) const HALF_WIDTH_DIVISOR: usize = 20;
 
-/// Passes of the moving average (spec §3 step 3.2).
+/// Passes of the moving average (docs/algorithms/salvi-varady.md §3 step 3.2).
 pub(super) const DEFAULT_PASSES: usize = 3;
 
 /// Coefficients of the B-spline target fit: `max(MIN_TARGET_COEFFICIENTS, ⌊N/20⌋)`.
@@ -42,7 +44,8 @@ pub(super) const LOOSE_SAMPLES_PER_COEFFICIENT: usize = 4;
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub enum Smoother {
-    /// Centred moving average, window truncated at the ends, repeated (normative, spec §3).
+    /// Centred moving average, window truncated at the ends, repeated (normative,
+    /// docs/algorithms/salvi-varady.md §3).
     MovingAverage {
         /// Half-width h in samples; `None`: `⌊N/20⌋`.
         half_width: Option<usize>,
@@ -96,9 +99,9 @@ pub(super) fn zero_speed(t: f64) -> Error {
     ))
 }
 
-/// The normative smoother (spec §3 step 3.2): a centred moving average of half-width h
-/// whose window is truncated at the ends (the mean of the samples that exist), applied
-/// `passes` times. O(N) per pass.
+/// The normative smoother (docs/algorithms/salvi-varady.md §3 step 3.2): a centred moving average
+/// of half-width h whose window is truncated at the ends (the mean of the samples that exist),
+/// applied `passes` times. O(N) per pass.
 pub(super) fn moving_average(values: &[f64], half_width: usize, passes: usize) -> Vec<f64> {
     let n = values.len();
     let mut cur = values.to_vec();
@@ -143,7 +146,7 @@ pub(super) fn sample_count(curve: &BSplineCurve, samples: Option<usize>) -> usiz
 }
 
 /// The target curvature g at the samples `t` of `curve`, whose curvature there is `kappa`
-/// (spec §3 step 3).
+/// (docs/algorithms/salvi-varady.md §3 step 3).
 ///
 /// # Errors
 /// [`Error::LengthMismatch`] for a given target of the wrong length or `kappa` not matching

@@ -1,6 +1,6 @@
 //! Salvi & Várady target-curvature fairing and Eck & Hadenfeld local energy fairing
-//! (spec §3): the `salvi_varady` test vectors, the properties of `sv.fair.properties`, and
-//! the behaviour of both methods on B-spline and point input.
+//! (docs/algorithms/salvi-varady.md §3): the `salvi_varady` test vectors, the properties of
+//! `sv.fair.properties`, and the behaviour of both methods on B-spline and point input.
 //!
 //! Unit tests (formerly `tests/salvi.rs`): they reach the target curvature and the shared
 //! local-fairing machinery of `fair/local.rs`, which are not public.

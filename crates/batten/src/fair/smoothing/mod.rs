@@ -3,8 +3,8 @@
 //!
 //! # The problem
 //!
-//! For points `P_0..P_{n−1}` at chord-length parameters `t_i` (spec §0.2) and weights `w_i`,
-//! find the C² cubic spline curve `C` with knots `t_i` that minimises
+//! For points `P_0..P_{n−1}` at chord-length parameters `t_i` (docs/algorithms/README.md §0.2) and
+//! weights `w_i`, find the C² cubic spline curve `C` with knots `t_i` that minimises
 //!
 //! ```text
 //! p · Σ_i w_i |P_i − C(t_i)|²  +  (1 − p) · ∫ |C''(t)|² dt ,        p ∈ [0, 1],

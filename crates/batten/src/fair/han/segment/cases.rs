@@ -1,13 +1,13 @@
 //! The case procedures of a function segment: the coarse phase (curvature vibrations, the
 //! indicator e) and the fine phase (inflections, c), each a closed-form move from a small
 //! linear system in the unit responses (`docs/algorithms/han.md`, "Coarse phase: curvature
-//! vibrations" and "Fine phase: inflections", spec §1.7.1–§1.7.3).
+//! vibrations" and "Fine phase: inflections", docs/algorithms/han.md §1.7.1–§1.7.3).
 
 use super::{CaseMove, MoveTag, Segment};
 
 /// A 2×2 system is treated as singular (the move is skipped) when `|det|` is at most this
 /// fraction of `|a11 a22| + |a12 a21|`. The systems of coarse case 3 and fine case 2 have
-/// condition numbers below 30 on sane grids (spec §1.7).
+/// condition numbers below 30 on sane grids (docs/algorithms/han.md §1.7).
 pub(super) const SINGULAR_REL: f64 = 1e-12;
 
 impl Segment {

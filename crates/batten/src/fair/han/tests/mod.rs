@@ -1,6 +1,6 @@
-//! Tests of the `han` method (spec §1): every `han.*` test vector, the properties of the unit
-//! responses, each fairing case on a constructed example, the curve pipeline (partition,
-//! strophoid, closed curves) and property tests (tolerance, fixed ends, rigid motions).
+//! Tests of the `han` method (docs/algorithms/han.md §1): every `han.*` test vector, the properties
+//! of the unit responses, each fairing case on a constructed example, the curve pipeline
+//! (partition, strophoid, closed curves) and property tests (tolerance, fixed ends, rigid motions).
 //!
 //! Unit tests (formerly `tests/han.rs`): they reach the paper's case procedures, the unit
 //! responses and the partition, which are not public.

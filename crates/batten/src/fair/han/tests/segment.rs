@@ -202,7 +202,7 @@ fn fine_case2_removes_a_pair() {
 
 #[test]
 fn segment_is_reflection_invariant() {
-    // y → −y mirrors every move (the α rule is symmetric, spec §1.7.2).
+    // y → −y mirrors every move (the α rule is symmetric, docs/algorithms/han.md §1.7.2).
     let v = vector("han.fair_segment.noisy_sine");
     let x = arr(&v["inputs"]["x"]);
     let y = arr(&v["inputs"]["y"]);
