@@ -5,7 +5,7 @@
 
 use crate::curve::Curve;
 use crate::error::{Error, Result};
-use crate::geom::{Point, Vec2};
+use crate::geom::{EndFix, Point, Vec2};
 use crate::spline::{BSplineCurve, MAX_ORDER};
 
 /// Smallest basis weight of a free control point at a curve end for `fix_ends` to eliminate
@@ -64,9 +64,10 @@ pub(super) struct Layout {
 impl Layout {
     pub(super) fn new(
         curve: &BSplineCurve,
-        fix_ends: Option<(Point, Point)>,
-        hold_end_derivatives: bool,
+        ends: EndFix,
+        end_points: Option<(Point, Point)>,
     ) -> Result<Layout> {
+        let hold_end_derivatives = ends.held() >= 2;
         let n = curve.control_points().len();
         let mut roles = vec![Role::Fixed; n];
         let mut elim = Vec::new();
@@ -79,7 +80,7 @@ impl Layout {
                 held[first..=first + curve.degree()].fill(true);
             }
         }
-        if let Some((p0, p1)) = fix_ends.filter(|_| !hold_end_derivatives) {
+        if let Some((p0, p1)) = end_points.filter(|_| ends == EndFix::Position) {
             let (a, b) = curve.domain();
             for (u, target) in [(a, p0), (b, p1)] {
                 let span = curve.find_span(u);

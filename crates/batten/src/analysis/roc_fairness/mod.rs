@@ -85,7 +85,7 @@
 //!   [`DEFAULT_METHOD_GRADIENT_FRACTION`]), the valid-sample fit for an explicit degree on an
 //!   inflected design, and `fix_ends` by elimination. With `--fix-ends=tangent` or
 //!   `curvature` every control point whose basis function is non-zero at a domain end is
-//!   held instead ([`ShapeConstraints::hold_end_derivatives`]), which keeps the end points,
+//!   held instead ([`ShapeConstraints::ends`]), which keeps the end points,
 //!   tangents and curvatures of the quintic exactly.
 //!
 //! # Files

@@ -9,7 +9,7 @@ use super::options::Residual;
 use super::samples::{Evaluator, RhoSamples, check_polynomial, sample_at_fractions};
 use crate::curve::Curve;
 use crate::error::{Error, Result};
-use crate::geom::Point;
+use crate::geom::{EndFix, Point};
 use crate::numeric::SymBanded;
 use crate::spline::{BSplineCurve, MAX_ORDER};
 
@@ -82,12 +82,12 @@ pub(crate) struct ShapeConstraints<'a> {
     /// A hard bound on `|C(u_k) − P_k|` over the anchors: a trial step that breaks it is
     /// rejected. Needs `anchors`.
     pub tolerance: Option<f64>,
-    /// Keep the curve's end points at these positions (see the module docs).
-    pub fix_ends: Option<(Point, Point)>,
-    /// Keep every control point whose basis function is non-zero at a domain end, so that the
-    /// curve's end points, tangents and curvatures stay exactly as they are
-    /// (`--fix-ends=tangent` / `curvature`; `fix_ends` is then not needed).
-    pub hold_end_derivatives: bool,
+    /// What to keep at the ends (`--fix-ends`). `Position`: the curve's end points at the
+    /// first and last anchor, by elimination (see the module docs); needs `anchors`.
+    /// `Tangent` and `Curvature`: every control point whose basis function is non-zero at a
+    /// domain end is held, so the curve's end points, tangents and curvatures stay exactly as
+    /// they are.
+    pub ends: EndFix,
 }
 
 impl ShapeConstraints<'_> {
@@ -228,11 +228,16 @@ pub(crate) fn modify_shape(
             reason: "a tolerance needs anchor points".into(),
         });
     }
-    let layout = Layout::new(
-        curve,
-        constraints.fix_ends,
-        constraints.hold_end_derivatives,
-    )?;
+    let end_points = constraints
+        .anchors
+        .and_then(|(_, original)| Some((*original.first()?, *original.last()?)));
+    if constraints.ends == EndFix::Position && end_points.is_none() {
+        return Err(Error::InvalidParameter {
+            name: "fix_ends".into(),
+            reason: "fixed end points need anchor points".into(),
+        });
+    }
+    let layout = Layout::new(curve, constraints.ends, end_points)?;
     let mut q: Vec<Point> = curve.control_points().to_vec();
     for e in &layout.elim {
         e.apply(&mut q);

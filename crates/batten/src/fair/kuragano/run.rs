@@ -67,11 +67,7 @@ pub(super) fn run_points(input: &PointSeq, options: &FairOptions) -> Result<Outc
             &ShapeConstraints {
                 anchors,
                 tolerance: options.tolerance,
-                fix_ends: options
-                    .fix_ends
-                    .is_fixed()
-                    .then(|| (points[0], points[m - 1])),
-                hold_end_derivatives: options.fix_ends.held() >= 2,
+                ends: options.fix_ends,
             },
         )?,
     };
