@@ -53,7 +53,7 @@ mod kuragano;
 // The local-move helpers the surface methods share with `salvi` and `eck-hadenfeld`.
 pub(crate) mod local;
 mod options;
-mod params;
+pub(crate) mod params;
 mod periodic;
 mod report;
 mod salvi;

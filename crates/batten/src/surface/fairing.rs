@@ -23,6 +23,7 @@ use super::{eck_hadenfeld, salvi};
 use crate::error::{Error, Result};
 use crate::fair::FairStatus;
 use crate::fair::local::{DEFAULT_TABU_LENGTH, DEFAULT_TOLERANCE_REL, ROUNDING_MARGIN_ULPS};
+use crate::fair::params::{Auto, Number, Param};
 
 /// Samples per knot span of the dense tolerance check, per direction.
 pub const DEVIATION_SAMPLES_PER_SPAN: usize = 10;
@@ -70,17 +71,76 @@ impl SurfaceMethod {
     pub fn keys(self) -> &'static [&'static str] {
         match self {
             SurfaceMethod::Salvi => &[
-                "samples_per_span",
-                "target_spans",
-                "smoothing",
-                "robust_passes",
-                "tabu",
-                "simplex_evaluations",
+                SAMPLES.name,
+                TARGET_SPANS.name,
+                SMOOTHING.name,
+                ROBUST_PASSES.name,
+                TABU.name,
+                SIMPLEX_EVALUATIONS.name,
             ],
-            SurfaceMethod::EckHadenfeld => &["tabu"],
+            SurfaceMethod::EckHadenfeld => &[TABU.name],
         }
     }
 }
+
+/// `tabu` (both methods): the length of the recently-moved list.
+const TABU: Param<Auto<usize>> = Param {
+    name: "tabu",
+    kind: Auto {
+        min: 0,
+        max: 100_000,
+    },
+    doc: "length of the recently-moved list; auto = max((p + 1)(q + 1), 4), the control points acting on one knot span; 0..=100000",
+};
+/// `samples_per_span` (`salvi`): curvature samples per knot span and direction.
+const SAMPLES: Param<Number<usize>> = Param {
+    name: "samples_per_span",
+    kind: Number {
+        default: super::sample::SAMPLES_PER_SPAN,
+        min: 1,
+        max: 64,
+    },
+    doc: "curvature samples per knot span in each direction; 1..=64",
+};
+/// `target_spans` (`salvi`): knot spans of the target surface in each direction.
+const TARGET_SPANS: Param<Auto<usize>> = Param {
+    name: "target_spans",
+    kind: Auto {
+        min: 1,
+        max: 10_000,
+    },
+    doc: "knot spans of the smooth target in each direction; auto = half the surface's spans, at least 2; 1..=10000",
+};
+/// `smoothing` (`salvi`): the target's smoothing weight.
+const SMOOTHING: Param<Number<f64>> = Param {
+    name: "smoothing",
+    kind: Number {
+        default: super::target::DEFAULT_SMOOTHING,
+        min: 0.0,
+        max: 1e12,
+    },
+    doc: "smoothing weight of the target surface's fit to the sampled curvatures; [0, 1e12]",
+};
+/// `robust_passes` (`salvi`): re-weighted passes of the target's fit.
+const ROBUST_PASSES: Param<Number<usize>> = Param {
+    name: "robust_passes",
+    kind: Number {
+        default: super::target::DEFAULT_ROBUST_PASSES,
+        min: 0,
+        max: 100,
+    },
+    doc: "robust re-weighting passes of the target's fit (outliers down-weighted); 0..=100",
+};
+/// `simplex_evaluations` (`salvi`): objective evaluations per local simplex search.
+const SIMPLEX_EVALUATIONS: Param<Number<usize>> = Param {
+    name: "simplex_evaluations",
+    kind: Number {
+        default: salvi::DEFAULT_SIMPLEX_EVALUATIONS,
+        min: 4,
+        max: 100_000,
+    },
+    doc: "objective evaluations of one control point's simplex search; 4..=100000",
+};
 
 /// Which control points along the four edges stay where they are.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Default)]
@@ -207,51 +267,25 @@ impl SurfaceFairOptions {
         Ok(())
     }
 
-    fn get<T: std::str::FromStr>(
-        &self,
-        key: &str,
-        ok: impl Fn(&T) -> bool,
-        what: &str,
-    ) -> Result<Option<T>> {
-        match self.params.get(key) {
-            None => Ok(None),
-            Some(text) => match text.parse::<T>() {
-                Ok(v) if ok(&v) => Ok(Some(v)),
-                _ => Err(Error::InvalidParameter {
-                    name: key.into(),
-                    reason: format!("'{text}' is not {what}"),
-                }),
-            },
-        }
+    fn text(&self, key: &str) -> Option<&str> {
+        self.params.get(key).map(String::as_str)
     }
 
     pub(crate) fn common(&self) -> Result<Common> {
         Ok(Common {
-            tabu: self.get::<usize>("tabu", |_| true, "a count")?,
+            tabu: TABU.read(self.text(TABU.name))?,
         })
     }
 
     pub(crate) fn salvi(&self) -> Result<salvi::SalviSurfaceParams> {
-        let d = salvi::SalviSurfaceParams::DEFAULT;
-        let pos = |x: &f64| x.is_finite() && *x >= 0.0;
         Ok(salvi::SalviSurfaceParams {
-            samples_per_span: self
-                .get("samples_per_span", |n: &usize| *n >= 1, "a count ≥ 1")?
-                .unwrap_or(d.samples_per_span),
+            samples_per_span: SAMPLES.read(self.text(SAMPLES.name))?,
             targets: TargetParams {
-                spans: self
-                    .get("target_spans", |n: &usize| *n >= 1, "a count ≥ 1")?
-                    .or(d.targets.spans),
-                smoothing: self
-                    .get("smoothing", pos, "a number ≥ 0")?
-                    .unwrap_or(d.targets.smoothing),
-                robust_passes: self
-                    .get("robust_passes", |_: &usize| true, "a count")?
-                    .unwrap_or(d.targets.robust_passes),
+                spans: TARGET_SPANS.read(self.text(TARGET_SPANS.name))?,
+                smoothing: SMOOTHING.read(self.text(SMOOTHING.name))?,
+                robust_passes: ROBUST_PASSES.read(self.text(ROBUST_PASSES.name))?,
             },
-            simplex_evaluations: self
-                .get("simplex_evaluations", |n: &usize| *n >= 4, "a count ≥ 4")?
-                .unwrap_or(d.simplex_evaluations),
+            simplex_evaluations: SIMPLEX_EVALUATIONS.read(self.text(SIMPLEX_EVALUATIONS.name))?,
         })
     }
 }
@@ -472,4 +506,59 @@ pub fn max_deviation(a: &BSplineSurface, b: &BSplineSurface, grid: &SampleGrid) 
         }
     }
     m
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    fn with(key: &str, value: &str) -> SurfaceFairOptions {
+        let mut o = SurfaceFairOptions::default();
+        o.params.insert(key.into(), value.into());
+        o
+    }
+
+    #[test]
+    fn the_declared_defaults_are_the_documented_ones() {
+        let o = SurfaceFairOptions::default();
+        assert_eq!(o.salvi().unwrap(), salvi::SalviSurfaceParams::DEFAULT);
+        assert_eq!(o.common().unwrap().tabu, None);
+        for (key, text) in [
+            ("samples_per_span", "4"),
+            ("target_spans", "auto"),
+            ("smoothing", "0.0001"),
+            ("robust_passes", "4"),
+            ("simplex_evaluations", "120"),
+            ("tabu", "auto"),
+        ] {
+            let given = with(key, text);
+            assert_eq!(
+                given.salvi().unwrap(),
+                salvi::SalviSurfaceParams::DEFAULT,
+                "{key}"
+            );
+            assert_eq!(given.common().unwrap().tabu, None, "{key}");
+        }
+    }
+
+    #[test]
+    fn bad_values_name_the_key_and_sizes_are_bounded() {
+        for (key, text) in [
+            ("samples_per_span", "0"),
+            ("samples_per_span", "65"),
+            ("target_spans", "0"),
+            ("smoothing", "-1"),
+            ("smoothing", "nan"),
+            ("robust_passes", "101"),
+            ("simplex_evaluations", "3"),
+            ("simplex_evaluations", "1e9"),
+            ("tabu", "x"),
+        ] {
+            let err = with(key, text).check().unwrap_err().to_string();
+            assert!(err.contains(key), "{key}={text}: {err}");
+        }
+        assert!(with("tabu", "7").check().is_ok());
+        assert_eq!(with("tabu", "7").common().unwrap().tabu, Some(7));
+    }
 }

@@ -36,7 +36,7 @@ use super::fairing::{MethodRun, Problem, tabu_length};
 use super::patch::{
     BSplineSurface, Homogeneous, SurfaceCurvature, Xyz, curvature_of, distance, rational_derivs,
 };
-use super::sample::{SAMPLES_PER_SPAN, SampleGrid};
+use super::sample::SampleGrid;
 use super::target::{TargetParams, Targets};
 use crate::error::Result;
 use crate::fair::FairStatus;
@@ -71,7 +71,7 @@ pub(super) const SIMPLEX_XATOL_REL: f64 = 1e-4;
 pub(crate) struct SalviSurfaceParams {
     /// Grid samples per knot span and direction.
     ///
-    /// Default value: [`SAMPLES_PER_SPAN`].
+    /// Default value: [`SAMPLES_PER_SPAN`](super::sample::SAMPLES_PER_SPAN).
     pub samples_per_span: usize,
     /// How the targets are fitted.
     ///
@@ -84,9 +84,11 @@ pub(crate) struct SalviSurfaceParams {
 }
 
 impl SalviSurfaceParams {
-    /// The defaults written on the fields.
+    /// The defaults written on the fields (the `--set` declarations of `fairing.rs` read to
+    /// them; a test checks it).
+    #[cfg(test)]
     pub(crate) const DEFAULT: SalviSurfaceParams = SalviSurfaceParams {
-        samples_per_span: SAMPLES_PER_SPAN,
+        samples_per_span: super::sample::SAMPLES_PER_SPAN,
         targets: TargetParams::DEFAULT,
         simplex_evaluations: DEFAULT_SIMPLEX_EVALUATIONS,
     };
