@@ -210,25 +210,38 @@ pub trait FairMethod: Sync {
         true
     }
 
+    /// The method's parameters given in data units, as `(name, power of length)` pairs: the
+    /// default [`params_at_scale`](FairMethod::params_at_scale) and
+    /// [`report_params_at_scale`](FairMethod::report_params_at_scale) convert them. The
+    /// default: none.
+    fn length_params(&self) -> &'static [(&'static str, i32)] {
+        &[]
+    }
+
     /// The options for a run on the coordinates divided by `s` (a power of two, see
     /// [`METHOD_SCALE_RANGE_LOG2`]): parameters given in data units converted. The common
-    /// path divides the tolerance itself. The default: no parameter in data units.
+    /// path divides the tolerance itself. The default converts the
+    /// [`length_params`](FairMethod::length_params).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] for a value that cannot be converted.
     fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
-        let _ = s;
-        Ok(options.clone())
+        Ok(guard::length_params_at_scale(
+            options,
+            self.length_params(),
+            s,
+        ))
     }
 
     /// Convert the reported parameters of a run on the coordinates divided by `s` back to
-    /// data units, where the method has some in data units. The default: none.
+    /// data units, where the method has some in data units. The default converts the
+    /// [`length_params`](FairMethod::length_params).
     fn report_params_at_scale(
         &self,
         parameters: &mut serde_json::Map<String, serde_json::Value>,
         s: f64,
     ) {
-        let _ = (parameters, s);
+        guard::report_length_params(parameters, self.length_params(), s);
     }
 }
 

@@ -416,20 +416,8 @@ impl FairMethod for SapidisFarin {
         true
     }
 
-    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
-        Ok(super::guard::length_params_at_scale(
-            options,
-            LENGTH_PARAMS,
-            s,
-        ))
-    }
-
-    fn report_params_at_scale(
-        &self,
-        parameters: &mut serde_json::Map<String, serde_json::Value>,
-        s: f64,
-    ) {
-        super::guard::report_length_params(parameters, LENGTH_PARAMS, s);
+    fn length_params(&self) -> &'static [(&'static str, i32)] {
+        LENGTH_PARAMS
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {

@@ -168,20 +168,8 @@ impl FairMethod for Kjellander {
         true
     }
 
-    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
-        Ok(super::guard::length_params_at_scale(
-            options,
-            UNIFORM_LENGTH_PARAMS,
-            s,
-        ))
-    }
-
-    fn report_params_at_scale(
-        &self,
-        parameters: &mut serde_json::Map<String, serde_json::Value>,
-        s: f64,
-    ) {
-        super::guard::report_length_params(parameters, UNIFORM_LENGTH_PARAMS, s);
+    fn length_params(&self) -> &'static [(&'static str, i32)] {
+        UNIFORM_LENGTH_PARAMS
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {
@@ -210,20 +198,8 @@ impl FairMethod for Poliakoff {
         true
     }
 
-    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
-        Ok(super::guard::length_params_at_scale(
-            options,
-            CHORD_LENGTH_PARAMS,
-            s,
-        ))
-    }
-
-    fn report_params_at_scale(
-        &self,
-        parameters: &mut serde_json::Map<String, serde_json::Value>,
-        s: f64,
-    ) {
-        super::guard::report_length_params(parameters, CHORD_LENGTH_PARAMS, s);
+    fn length_params(&self) -> &'static [(&'static str, i32)] {
+        CHORD_LENGTH_PARAMS
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {
@@ -252,20 +228,8 @@ impl FairMethod for Energy {
         true
     }
 
-    fn params_at_scale(&self, options: &FairOptions, s: f64) -> Result<FairOptions> {
-        Ok(super::guard::length_params_at_scale(
-            options,
-            CHORD_LENGTH_PARAMS,
-            s,
-        ))
-    }
-
-    fn report_params_at_scale(
-        &self,
-        parameters: &mut serde_json::Map<String, serde_json::Value>,
-        s: f64,
-    ) {
-        super::guard::report_length_params(parameters, CHORD_LENGTH_PARAMS, s);
+    fn length_params(&self) -> &'static [(&'static str, i32)] {
+        CHORD_LENGTH_PARAMS
     }
 
     fn check_params(&self, options: &FairOptions) -> Result<()> {
