@@ -470,21 +470,12 @@ impl FairMethod for SapidisFarin {
             }),
         );
         let points = state.output(&initial)?;
+        // P_0 and P_1 (and their mirror at the other end) are held: the end points (the
+        // curve's end tangents too, but not the second points, which `tangent` means). The
+        // wrapped form of a closed curve is not a curve of its own: none is returned.
         Ok(Outcome {
-            solver: None,
-            points,
-            status: driven.status,
-            iterations: driven.moves.len(),
-            moves: driven.moves,
-            history: driven.history,
-            parameters,
-            notes: driven.notes,
-            // The wrapped form of a closed curve is not a curve of its own: none is returned.
             curve: (!closed).then_some(state.curve),
-            tangents: None,
-            // P_0 and P_1 (and their mirror at the other end) are held: the end points (the
-            // curve's end tangents too, but not the second points, which `tangent` means).
-            ends_held: Some(super::EndFix::Position),
+            ..driven.into_outcome(points, parameters)
         })
     }
 }

@@ -8,7 +8,8 @@ use serde_json::{Map, Value, json};
 
 use crate::error::{Error, Result};
 use crate::fair::params::{Auto, Number, Param};
-use crate::fair::{FairOptions, FairStatus, HistoryRow, Move, ParamSpec};
+use crate::fair::{EndFix, FairOptions, FairStatus, HistoryRow, Move, Outcome, ParamSpec};
+use crate::geom::Point;
 
 /// Default relative stopping threshold: the run stops when every `|J_k|` is at most this
 /// fraction of the largest jump of the input.
@@ -215,6 +216,31 @@ pub(crate) struct Driven {
     pub(crate) notes: Vec<String>,
     pub(crate) epsilon: f64,
     pub(crate) initial_max: f64,
+}
+
+impl Driven {
+    /// The method's outcome: `points` faired by these moves, with the method's report
+    /// `parameters`; the end points held (the engine never moves them), no curve, no
+    /// tangents (a caller with either sets it).
+    pub(crate) fn into_outcome(
+        self,
+        points: Vec<Point>,
+        parameters: Map<String, Value>,
+    ) -> Outcome {
+        Outcome {
+            solver: None,
+            points,
+            status: self.status,
+            iterations: self.moves.len(),
+            moves: self.moves,
+            history: self.history,
+            parameters,
+            notes: self.notes,
+            curve: None,
+            tangents: None,
+            ends_held: Some(EndFix::Position),
+        }
+    }
 }
 
 fn checked_badness(p: &impl LocalProblem, i: usize) -> Result<f64> {

@@ -150,16 +150,7 @@ pub fn fair_hermite(
     let driven = drive(&mut state, threshold, max_moves, options.tolerance)?;
     let parameters = driven_parameters(&driven, threshold, max_moves);
     Ok(Outcome {
-        solver: None,
-        points: state.r,
-        status: driven.status,
-        iterations: driven.moves.len(),
-        moves: driven.moves,
-        history: driven.history,
-        parameters,
-        notes: driven.notes,
-        curve: None,
         tangents: Some(state.m),
-        ends_held: Some(crate::fair::EndFix::Position),
+        ..driven.into_outcome(state.r, parameters)
     })
 }

@@ -319,19 +319,7 @@ pub(super) fn run_points(
         MODE.write(&mut parameters, mode);
     }
     parameters.insert("solve_half_width".into(), json!(SOLVE_HALF_WIDTH));
-    Ok(Outcome {
-        solver: None,
-        points: state.r,
-        status: driven.status,
-        iterations: driven.moves.len(),
-        moves: driven.moves,
-        history: driven.history,
-        parameters,
-        notes: driven.notes,
-        curve: None,
-        tangents: None,
-        ends_held: Some(crate::fair::EndFix::Position),
-    })
+    Ok(driven.into_outcome(state.r, parameters))
 }
 
 #[cfg(test)]
