@@ -7,12 +7,11 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::curvature::{curvature_derivative, signed_curvature};
-use super::gfi::{fairness_indicators, lfi_from_samples};
 use crate::error::{Error, Result};
 use crate::geom::{Point, PointSeq, Vec2};
 use crate::numeric::GaussLegendre;
 use crate::spline::{
-    BSplineCurve, EndCondition, ParametricCubic, Parametrization, c2_closed_tangents, c2_tangents,
+    EndCondition, ParametricCubic, Parametrization, c2_closed_tangents, c2_tangents,
     hermite_coeffs, parameters, span_derivatives,
 };
 
@@ -55,11 +54,10 @@ struct SpanSums {
     /// Largest |r''' jump| at the knots inside the chunk.
     max_third_jump: f64,
     max_curvature: f64,
-    /// Arc length of the chunk, and at each of its spans' starts from the chunk's start
-    /// (closed curves only, for the GFI, as the curvatures at the knots).
+    /// Arc length of the chunk.
     length: f64,
-    s_knots: Vec<f64>,
-    kappa_knots: Vec<f64>,
+    /// The sum of Calì's LFI at the chunk's knots.
+    gfi: f64,
     strain: f64,
     variation: f64,
 }
@@ -225,9 +223,9 @@ pub struct FairnessMetrics {
     pub variation_energy: f64,
     /// Largest |κ| (sampled densely).
     pub max_curvature: f64,
-    /// Calì's global fairness indicator (docs/algorithms/cali.md §4.4) on the cubic B-spline
-    /// interpolant with averaging knots (open curves), or on the periodic spline at its knots
-    /// (closed curves).
+    /// Calì's global fairness indicator (docs/algorithms/cali.md §4.4) on the analysis curve at
+    /// its knots, the data points: the sum over the knots of the squared second divided
+    /// difference of κ in arc length (cyclic when closed; none at an open curve's two ends).
     pub gfi: f64,
     /// Largest `|r'''(t_k+) − r'''(t_k−)|` at the knots of the analysis curve (the bad-point
     /// measure of Kjellander and Poliakoff).
@@ -330,38 +328,27 @@ impl FairnessMetrics {
             mut kappa_runs,
             dk_runs,
             jump_runs,
-            s_knots,
-            kappa_knots,
+            gfi,
             max_curvature,
             length,
             strain,
             variation,
             max_third_derivative_jump,
-        } = Joined::of(chunks, closed, m, dk_floor);
+        } = Joined::of(chunks, closed, dk_floor);
         if !closed {
+            // The end knot t_m, from the last span: its sign for the inflections, and its
+            // curvature and arc length for the GFI.
             let c = spans.coeffs(m - 1);
             let d = span_derivatives(&c, t[m] - t[m - 1]);
+            let kappa_end = signed_curvature(&d);
             let mut end = SignRuns::default();
-            end.push(signed_curvature(&d), kappa_floor);
+            end.push(kappa_end, kappa_floor);
             kappa_runs.push(end);
         }
         let inflections = count_runs(&kappa_runs, closed);
         let curvature_extrema = count_runs(&dk_runs, closed);
         let vibrations = count_runs(&jump_runs, closed);
         drop((kappa_runs, dk_runs, jump_runs));
-
-        let gfi = if closed {
-            lfi_from_samples(&kappa_knots, &s_knots, Some(length))
-                .iter()
-                .sum()
-        } else {
-            // The open GFI is measured on another spline, through the same chord-length
-            // parameters: free the tangents first, so that the two are never held at once.
-            let AnalysisSpans { t, tangents, .. } = spans;
-            drop(tangents);
-            let (bs, _) = BSplineCurve::interpolate_at_parameters(seq.points(), 3, t)?;
-            fairness_indicators(&bs).gfi
-        };
 
         Ok(FairnessMetrics {
             points: seq.len(),
@@ -386,8 +373,7 @@ struct Joined {
     kappa_runs: Vec<SignRuns>,
     dk_runs: Vec<SignRuns>,
     jump_runs: Vec<SignRuns>,
-    s_knots: Vec<f64>,
-    kappa_knots: Vec<f64>,
+    gfi: f64,
     max_curvature: f64,
     length: f64,
     strain: f64,
@@ -396,16 +382,14 @@ struct Joined {
 }
 
 impl Joined {
-    /// Join `chunks` (in order) of a curve of `m` spans.
-    fn of(chunks: Vec<SpanSums>, closed: bool, m: usize, dk_floor: f64) -> Joined {
-        // The runs of each quantity, part by part in order (counted, then freed, before the
-        // GFI's spline is built).
+    /// Join `chunks` (in order).
+    fn of(chunks: Vec<SpanSums>, closed: bool, dk_floor: f64) -> Joined {
+        // The runs of each quantity, part by part in order.
         let mut kappa_runs = Vec::with_capacity(chunks.len() + 1);
         let mut dk_runs = Vec::with_capacity(chunks.len());
         let mut jump_runs = Vec::with_capacity(2 * chunks.len());
-        let mut s_knots = Vec::with_capacity(if closed { m + 1 } else { 0 });
-        let mut kappa_knots = Vec::with_capacity(if closed { m } else { 0 });
         let (mut max_curvature, mut length, mut strain, mut variation) = (0.0_f64, 0.0, 0.0, 0.0);
+        let mut gfi = 0.0;
         let mut max_third_derivative_jump = 0.0_f64;
         let knot = |v: f64| {
             let mut r = SignRuns::default();
@@ -432,10 +416,7 @@ impl Joined {
             jump_runs.push(r.jumps);
             max_curvature = max_curvature.max(r.max_curvature);
             max_third_derivative_jump = max_third_derivative_jump.max(r.max_third_jump);
-            if closed {
-                s_knots.extend(r.s_knots.iter().map(|s| length + s));
-                kappa_knots.extend_from_slice(&r.kappa_knots);
-            }
+            gfi += r.gfi;
             length += r.length;
             strain += r.strain;
             variation += r.variation;
@@ -444,8 +425,7 @@ impl Joined {
             kappa_runs,
             dk_runs,
             jump_runs,
-            s_knots,
-            kappa_knots,
+            gfi,
             max_curvature,
             length,
             strain,
@@ -494,6 +474,11 @@ impl<'a> AnalysisSpans<'a> {
         self.t.len() - 1
     }
 
+    /// Whether the curve is closed (its last span ends at the first point).
+    fn is_closed(&self) -> bool {
+        self.points.len() == self.len()
+    }
+
     /// Span `i`'s coefficients `[a0, a1, a2, a3]` in `s = t − t_i`.
     #[inline]
     fn coeffs(&self, i: usize) -> [Vec2; 4] {
@@ -516,11 +501,8 @@ impl<'a> AnalysisSpans<'a> {
         dk_floor: f64,
     ) -> SpanSums {
         let t = &self.t;
-        let closed = self.points.len() == self.len();
         let mut r = SpanSums {
             finite: true,
-            s_knots: Vec::with_capacity(if closed { spans.len() } else { 0 }),
-            kappa_knots: Vec::with_capacity(if closed { spans.len() } else { 0 }),
             ..SpanSums::default()
         };
         // The rule as fixed-size arrays, so that the node loop is unrolled and vectorised.
@@ -529,6 +511,22 @@ impl<'a> AnalysisSpans<'a> {
         nodes.copy_from_slice(gl.nodes());
         weights.copy_from_slice(gl.weights());
         let first = spans.start;
+        let m = self.len();
+        // Calì's LFI at each knot of the chunk (docs/algorithms/cali.md §4.4), from the
+        // curvatures at the knots and the spans' lengths: (κ, length) of the knot and span
+        // two before the current one and of those just before it. The chunk's first knot
+        // needs the span before the chunk (a closed curve's last span before its first).
+        let mut back: Option<(f64, f64)> = None;
+        let mut prev: Option<(f64, f64)> = (first > 0 || self.is_closed()).then(|| {
+            let j = (first + m - 1) % m;
+            let c = self.coeffs(j);
+            let kappa = signed_curvature(&span_derivatives(&c, 0.0));
+            (
+                kappa,
+                span_terms(&c, t[j + 1] - t[j], &nodes, &weights).length,
+            )
+        });
+        let mut kappa_end = 0.0;
         let mut last_left_dk = 0.0;
         let mut last_a3 = Vec2::ZERO;
         for i in spans {
@@ -540,8 +538,8 @@ impl<'a> AnalysisSpans<'a> {
             let d0 = span_derivatives(&c, 0.0);
             let kappa0 = signed_curvature(&d0);
             r.kappa.push(kappa0, kappa_floor);
-            if closed {
-                r.kappa_knots.push(kappa0);
+            if let (Some((kb, lb)), Some((kp, lp))) = (back, prev) {
+                r.gfi += lfi(kb, kp, kappa0, lb, lp);
             }
             // cross(s) = 6(a2×a3) s² + 6(a1×a3) s + 2(a1×a2)
             let qa = 6.0 * a2.cross(a3);
@@ -563,7 +561,8 @@ impl<'a> AnalysisSpans<'a> {
                 let j = (a3 - last_a3) * 6.0;
                 r.max_third_jump = r.max_third_jump.max(j.length());
             }
-            last_left_dk = curvature_derivative(&span_derivatives(&c, t[i + 1] - t[i]));
+            let d_end = span_derivatives(&c, t[i + 1] - t[i]);
+            last_left_dk = curvature_derivative(&d_end);
             last_a3 = a3;
 
             // Dense samples: the sign of dκ/ds and the largest κ², without square roots; the
@@ -586,22 +585,17 @@ impl<'a> AnalysisSpans<'a> {
                 r.max_curvature = r.max_curvature.max(k.abs());
             }
 
-            if closed {
-                r.s_knots.push(r.length);
-            }
-            let half = 0.5 * h;
-            let mid = t[i] + half;
-            let mut at = [0.0; QUADRATURE_NODES];
-            for (s, x) in at.iter_mut().zip(&nodes) {
-                *s = (mid + half * x) - t[i];
-            }
-            let q = SampleTerms::at(&c, &at);
-            for j in 0..QUADRATURE_NODES {
-                let ws = weights[j] * half * q.w[j].sqrt();
-                r.length += ws;
-                r.strain += ws * q.kappa2[j];
-                r.variation += ws * q.dkappa_ds[j] * q.dkappa_ds[j];
-            }
+            let q = span_terms(&c, h, &nodes, &weights);
+            r.length += q.length;
+            r.strain += q.strain;
+            r.variation += q.variation;
+
+            (back, prev) = (prev, Some((kappa0, q.length)));
+            kappa_end = signed_curvature(&d_end);
+        }
+        // The chunk's last knot, with the knot at the end of its last span.
+        if let (Some((kb, lb)), Some((kp, lp))) = (back, prev) {
+            r.gfi += lfi(kb, kp, kappa_end, lb, lp);
         }
         r.last_left_dk = last_left_dk;
         r.last_a3 = last_a3;
@@ -610,6 +604,52 @@ impl<'a> AnalysisSpans<'a> {
         }
         r
     }
+}
+
+/// A span's length and energies by the quadrature rule of [`FairnessMetrics::of_seq`].
+struct SpanIntegrals {
+    length: f64,
+    strain: f64,
+    variation: f64,
+}
+
+/// [`SpanIntegrals`] of the span with coefficients `c` over `[0, h]` (the rule's nodes and
+/// weights on `[−1, 1]`).
+#[inline]
+fn span_terms(
+    c: &[Vec2; 4],
+    h: f64,
+    nodes: &[f64; QUADRATURE_NODES],
+    weights: &[f64; QUADRATURE_NODES],
+) -> SpanIntegrals {
+    let half = 0.5 * h;
+    let mut at = [0.0; QUADRATURE_NODES];
+    for (s, x) in at.iter_mut().zip(nodes) {
+        // The node's offset from the span's start.
+        *s = half + half * x;
+    }
+    let q = SampleTerms::at(c, &at);
+    let mut r = SpanIntegrals {
+        length: 0.0,
+        strain: 0.0,
+        variation: 0.0,
+    };
+    for j in 0..QUADRATURE_NODES {
+        let ws = weights[j] * half * q.w[j].sqrt();
+        r.length += ws;
+        r.strain += ws * q.kappa2[j];
+        r.variation += ws * q.dkappa_ds[j] * q.dkappa_ds[j];
+    }
+    r
+}
+
+/// Calì's `LFI = (κ'')²` at a knot (docs/algorithms/cali.md §4.4): the second divided
+/// difference of the curvatures `k0` before, `k1` at and `k2` after it, the spans between them
+/// of arc lengths `l0` and `l1`.
+#[inline]
+fn lfi(k0: f64, k1: f64, k2: f64, l0: f64, l1: f64) -> f64 {
+    let d = 2.0 * ((k2 - k1) / l1 - (k1 - k0) / l0) / (l0 + l1);
+    d * d
 }
 
 /// κ² and dκ/ds of a span at `N` parameters, without square roots: with `w = |r'|²`,
@@ -872,6 +912,30 @@ mod tests {
             assert_eq!(got.max_third_derivative_jump, third);
             // Energies and length by the general quadrature on the curve.
             let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+            // The GFI: Calì's divided differences of κ at the knots over the arc lengths
+            // there, cyclic when closed, summed (as `fairness_indicators` sums them).
+            let mut s = vec![0.0];
+            for i in 0..m {
+                let gl = GaussLegendre::new(QUADRATURE_NODES);
+                let len = gl.integrate(t[i], t[i + 1], |x| {
+                    curve.derivatives_in_span(i, x).d1.length()
+                });
+                s.push(s[i] + len);
+            }
+            let mut kappa_knots: Vec<f64> = (0..m)
+                .map(|i| signed_curvature(&curve.derivatives_in_span(i, t[i])))
+                .collect();
+            if closed {
+                s.pop();
+            } else {
+                kappa_knots.push(signed_curvature(&curve.derivatives_in_span(m - 1, t[m])));
+            }
+            let period = closed.then_some(got.length);
+            let gfi: f64 = super::super::gfi::lfi_from_samples(&kappa_knots, &s, period)
+                .iter()
+                .sum();
+            assert!(rel(got.gfi, gfi) < 1e-9, "{} {gfi}", got.gfi);
+            assert!(got.gfi > 0.0);
             assert!(rel(got.length, crate::analysis::arc_length(&curve)) < 1e-13);
             assert!(rel(got.strain_energy, crate::analysis::strain_energy(&curve)) < 1e-12);
             assert!(
