@@ -141,27 +141,95 @@ fn planar_rows(piece: &str) -> Option<(Vec<Point>, Vec<usize>, usize)> {
     let mut count = 0;
     for (i, raw) in piece.lines().enumerate() {
         count = i + 1;
-        let content = match raw.find('#') {
-            Some(k) => &raw[..k],
-            None => raw,
-        }
-        .trim();
-        if content.is_empty() {
-            continue;
-        }
-        let mut fields = [""; 3];
-        if first_fields(content, &mut fields) != 2 {
-            return None;
-        }
-        let x = fields[0].parse::<f64>().ok()?;
-        let y = fields[1].parse::<f64>().ok()?;
-        if !(x.is_finite() && y.is_finite()) {
-            return None;
-        }
+        let row = plain_row(raw).unwrap_or_else(|| general_row(raw))?;
+        let Some([x, y]) = row else {
+            continue; // empty or a comment
+        };
         points.push(Point::new(x, y));
         lines.push(i + 1);
     }
     Some((points, lines, count))
+}
+
+/// A row of [`planar_rows`]: `Some(Some([x, y]))` a point, `Some(None)` a line without
+/// content, `None` a line that [`parse_sequential`] would refuse.
+type PlanarRow = Option<Option<[f64; 2]>>;
+
+/// [`planar_rows`]' rules for one line by the general path: comments, `;` and `,` separators,
+/// quotes, Unicode spaces.
+fn general_row(raw: &str) -> PlanarRow {
+    let content = match raw.find('#') {
+        Some(k) => &raw[..k],
+        None => raw,
+    }
+    .trim();
+    if content.is_empty() {
+        return Some(None);
+    }
+    let mut fields = [""; 3];
+    if first_fields(content, &mut fields) != 2 {
+        return None;
+    }
+    number_pair(fields[0], fields[1]).map(Some)
+}
+
+/// Two finite numbers, as [`parse_sequential`] reads fields.
+#[inline]
+fn number_pair(x: &str, y: &str) -> Option<[f64; 2]> {
+    let x = x.parse::<f64>().ok()?;
+    let y = y.parse::<f64>().ok()?;
+    (x.is_finite() && y.is_finite()).then_some([x, y])
+}
+
+/// Whether `b` is an ASCII character that `char::is_whitespace` accepts (which, unlike
+/// `u8::is_ascii_whitespace`, includes the vertical tab).
+#[inline]
+fn ascii_space(b: u8) -> bool {
+    matches!(b, b' ' | b'\t' | b'\n' | b'\x0b' | b'\x0c' | b'\r')
+}
+
+/// `s` less its leading and trailing [`ascii_space`]s, as text (`s` is ASCII).
+fn trim(s: &[u8]) -> &str {
+    let start = s.iter().position(|&c| !ascii_space(c)).unwrap_or(s.len());
+    let end = s
+        .iter()
+        .rposition(|&c| !ascii_space(c))
+        .map_or(start, |e| e + 1);
+    std::str::from_utf8(&s[start..end]).unwrap_or_default()
+}
+
+/// [`general_row`] in one pass over the bytes, for the lines of a large file that are plain
+/// ASCII without `#`, `;` or `"` (nearly all of them): `x,y` or `x y`. `None` for any other
+/// line, which then takes the general path; the same result as it otherwise.
+#[inline]
+fn plain_row(raw: &str) -> Option<PlanarRow> {
+    let b = raw.as_bytes();
+    let mut comma = None;
+    let mut commas = 0;
+    for (k, &c) in b.iter().enumerate() {
+        match c {
+            b',' => {
+                commas += 1;
+                comma = Some(k);
+            }
+            b'#' | b';' | b'"' => return None,
+            c if c >= 0x80 => return None,
+            _ => {}
+        }
+    }
+    if let Some(k) = comma {
+        if commas != 1 {
+            return Some(None); // three fields or more: refused
+        }
+        return Some(number_pair(trim(&b[..k]), trim(&b[k + 1..])).map(Some));
+    }
+    // Whitespace-separated: exactly two runs of non-space characters, or none at all.
+    let mut fields = b.split(|&c| ascii_space(c)).filter(|f| !f.is_empty());
+    match (fields.next(), fields.next(), fields.next()) {
+        (None, _, _) => Some(Some(None)),
+        (Some(x), Some(y), None) => Some(number_pair(trim(x), trim(y)).map(Some)),
+        _ => Some(None),
+    }
 }
 
 /// The text format read line by line (see the module documentation).
@@ -416,6 +484,49 @@ mod tests {
             let _ = writeln!(want, "{},{}", format_f64(p.x), format_f64(p.y));
         }
         assert_eq!(format(&pts), want);
+    }
+
+    #[test]
+    fn plain_rows_read_as_the_general_path_does() {
+        let lines = [
+            "1,2",
+            " 1 , 2 ",
+            "1,2,3",
+            ",",
+            "",
+            "   ",
+            "\x0b1\x0b2\x0b",
+            "1\x0b,\x0c2",
+            "1",
+            "1 2 3",
+            "1\t2",
+            "1e5,-2.5e-3",
+            "inf,1",
+            "NaN,2",
+            "1e400,1",
+            "\u{a0}1,2",
+            "1\u{a0}2",
+            "1 ,",
+            ",2",
+            "1,,",
+            "a,b",
+            "+1,-2",
+            ".5, 5.",
+            "1_0,2",
+            "0x10,1",
+            "1 2#c",
+            "\"1\",2",
+            "1;2",
+            "1\r",
+            "1,2\r",
+            " \t ",
+            "-0,0",
+            "1e-320,5",
+        ];
+        for line in lines {
+            let general = general_row(line);
+            assert_eq!(plain_row(line).unwrap_or(general), general, "{line:?}");
+        }
     }
 
     #[test]
