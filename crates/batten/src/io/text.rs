@@ -88,15 +88,15 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<ParsedText, IoError> {
 fn parse_parallel(bytes: &[u8]) -> Option<ParsedText> {
     use rayon::prelude::*;
 
-    let text = std::str::from_utf8(bytes).ok()?;
-    // The end of the line that `from` is in (`from` ≤ the length).
+    // The end of the line that `from` is in (`from` ≤ the length). Cut at line ends, the
+    // pieces are whole UTF-8 sequences, each checked where it is read.
     let cut = |from: usize| -> usize {
-        match text.as_bytes()[from..].iter().position(|&b| b == b'\n') {
+        match bytes[from..].iter().position(|&b| b == b'\n') {
             Some(k) => from + k + 1,
-            None => text.len(),
+            None => bytes.len(),
         }
     };
-    let split = cut(PREFIX_BYTES.min(text.len()));
+    let split = cut(PREFIX_BYTES.min(bytes.len()));
     let prefix = parse_sequential(&bytes[..split], Path::new("")).ok()?;
     let Coords::Planar(mut points) = prefix.coords else {
         return None;
@@ -104,17 +104,18 @@ fn parse_parallel(bytes: &[u8]) -> Option<ParsedText> {
     if points.is_empty() {
         return None;
     }
-    let prefix_lines = text[..split].lines().count();
+    // The prefix ends at a line end when pieces follow it: its lines are its line ends.
+    let prefix_lines = bytes[..split].iter().filter(|&&b| b == b'\n').count();
     let mut pieces = Vec::new();
     let mut start = split;
-    while start < text.len() {
-        let end = cut((start + PIECE_BYTES).min(text.len()));
-        pieces.push(&text[start..end]);
+    while start < bytes.len() {
+        let end = cut((start + PIECE_BYTES).min(bytes.len()));
+        pieces.push(&bytes[start..end]);
         start = end;
     }
     let parsed: Vec<(Vec<Point>, Vec<usize>, usize)> = pieces
         .par_iter()
-        .map(|piece| planar_rows(piece))
+        .map(|piece| planar_rows(std::str::from_utf8(piece).ok()?))
         .collect::<Option<_>>()?;
     let total: usize = parsed.iter().map(|p| p.0.len()).sum();
     points.reserve_exact(total);

@@ -48,12 +48,22 @@ pub fn parameters(points: &[Point], kind: Parametrization, closed: bool) -> Resu
     }
     let n = points.len();
     let m = if closed { n } else { n.saturating_sub(1) };
+    let chord = |i: usize| (points[(i + 1) % n] - points[i]).length();
+    // The chord lengths (hypot, the costly part) in parallel for long sequences, then summed
+    // in order: the same bits with any number of threads.
+    let lengths: Vec<f64> = if m >= PARALLEL_CHORDS {
+        use rayon::prelude::*;
+        (0..m)
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(chord)
+            .collect()
+    } else {
+        (0..m).map(chord).collect()
+    };
     let mut t = Vec::with_capacity(m + 1);
     t.push(0.0);
-    for i in 0..m {
-        let a = points[i];
-        let b = points[(i + 1) % n];
-        let d = (b - a).length();
+    for (i, &d) in lengths.iter().enumerate() {
         if d == 0.0 {
             return Err(Error::DuplicatePoint { index: (i + 1) % n });
         }
@@ -66,6 +76,9 @@ pub fn parameters(points: &[Point], kind: Parametrization, closed: bool) -> Resu
     }
     Ok(t)
 }
+
+/// [`parameters`] measures the chords of at least this many in parallel.
+const PARALLEL_CHORDS: usize = 1 << 16;
 
 /// A piecewise cubic Hermite curve through `P_0..P_m` at parameters `t_0 < … < t_m`; each span
 /// is the cubic with the end positions and first derivatives of its knots (KP eq 6).
