@@ -526,7 +526,7 @@ impl<'a> AnalysisSpans<'a> {
                 span_terms(&c, t[j + 1] - t[j], &nodes, &weights).length,
             )
         });
-        let mut kappa_end = 0.0;
+        let mut d_end = None;
         let mut last_left_dk = 0.0;
         let mut last_a3 = Vec2::ZERO;
         for i in spans {
@@ -561,8 +561,9 @@ impl<'a> AnalysisSpans<'a> {
                 let j = (a3 - last_a3) * 6.0;
                 r.max_third_jump = r.max_third_jump.max(j.length());
             }
-            let d_end = span_derivatives(&c, t[i + 1] - t[i]);
-            last_left_dk = curvature_derivative(&d_end);
+            let d = span_derivatives(&c, t[i + 1] - t[i]);
+            last_left_dk = curvature_derivative(&d);
+            d_end = Some(d);
             last_a3 = a3;
 
             // Dense samples: the sign of dκ/ds and the largest κ², without square roots; the
@@ -591,11 +592,10 @@ impl<'a> AnalysisSpans<'a> {
             r.variation += q.variation;
 
             (back, prev) = (prev, Some((kappa0, q.length)));
-            kappa_end = signed_curvature(&d_end);
         }
         // The chunk's last knot, with the knot at the end of its last span.
-        if let (Some((kb, lb)), Some((kp, lp))) = (back, prev) {
-            r.gfi += lfi(kb, kp, kappa_end, lb, lp);
+        if let (Some((kb, lb)), Some((kp, lp)), Some(d)) = (back, prev, d_end) {
+            r.gfi += lfi(kb, kp, signed_curvature(&d), lb, lp);
         }
         r.last_left_dk = last_left_dk;
         r.last_a3 = last_a3;
