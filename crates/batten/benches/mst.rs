@@ -47,7 +47,7 @@ fn bench(c: &mut Criterion) {
     g.bench_function("fit_collinear/100000", |b| {
         b.iter(|| SmoothingSpline::fit(black_box(&t), black_box(&line), None, 0.5).unwrap())
     });
-    // `bench/python_speed.py`'s curve and tolerance: the bisection's ~19 fits, then the whole
+    // `bench/python_speed.py`'s curve and tolerance: the search's fits (12 here), then the whole
     // `fair` (the search plus the report's measures before and after).
     let small = noisy_sine(200);
     let t = parameters(&small, Parametrization::ChordLength, false).unwrap();

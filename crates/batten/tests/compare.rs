@@ -46,7 +46,7 @@ fn mst_runs_at_the_largest_displacement_of_the_first_method() {
                 )),
             "{note}"
         );
-        // The bisection returns the feasible end of a bracket of relative width
+        // The search returns the feasible end of a bracket of relative width
         // BISECTION_REL_PRECISION in its smoothing weight; the largest displacement grows
         // no faster than that weight, so it lands within that fraction below the target.
         let got = mst.report().unwrap().max_displacement;

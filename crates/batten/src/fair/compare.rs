@@ -84,7 +84,7 @@ pub enum ComparisonOutcome {
 /// displacement. Han et al. run the smoothing spline at the largest displacement of their
 /// method, and so does this: every method runs with `options`, except `mst` (the smoothing
 /// spline) when another method is listed first. `mst` then runs with `tolerance` = that
-/// method's largest displacement and no method parameters, which makes it bisect on its
+/// method's largest displacement and no method parameters, which makes it search its
 /// smoothing parameter for the smoothest spline within it ([`SmoothingSpline`](crate::fair::SmoothingSpline)), and its
 /// row's [`note`](ComparisonRow::note) says so. When the first method fails, is skipped or
 /// moves no point, `mst` runs with `options` and the note says why.

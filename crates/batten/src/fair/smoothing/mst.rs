@@ -5,7 +5,7 @@
 
 use serde_json::{Map, Value};
 
-use super::{DEFAULT_MAX_BISECTION_STEPS, Smoothing, check_p, param_p, roughness, select_any};
+use super::{DEFAULT_MAX_SEARCH_STEPS, Smoothing, check_p, param_p, roughness, select_any};
 use crate::error::Result;
 use crate::fair::{
     FairMethod, FairOptions, FairStatus, HistoryRow, Outcome, ParamSpec, SpaceOutcome,
@@ -33,7 +33,7 @@ static PARAMS: &[ParamSpec] = &[P.spec()];
 ///
 /// Reports `p`, `alpha`, `selection` (`given`, `tolerance`, `gcv`), `roughness` and, for GCV,
 /// `gcv` and `degrees_of_freedom` in [`Outcome::parameters`]; iterations are the splines the
-/// search computed (bisection steps or GCV evaluations). [`Outcome::curve`] is left empty: the
+/// search computed (the tolerance search's fits or GCV evaluations). [`Outcome::curve`] is left empty: the
 /// method's product is the points, and building the curve would triple its cost at 10⁶
 /// points; the library's [`SmoothingSpline::curve`](super::SmoothingSpline::curve) gives the spline itself
 /// (`BSplineCurve::from_parametric_cubic` turns it into exact B-spline form).
@@ -168,7 +168,7 @@ fn run_points<const D: usize>(
         (None, Some(tolerance)) => (
             Smoothing::MaxDisplacement {
                 tolerance,
-                max_steps: options.iterations_or(DEFAULT_MAX_BISECTION_STEPS),
+                max_steps: options.iterations_or(DEFAULT_MAX_SEARCH_STEPS),
             },
             "tolerance",
         ),

@@ -362,6 +362,32 @@ impl<'a, const D: usize> Problem<'a, D> {
         std::array::from_fn(|c| term(im, im, c) + term(ip, i, c))
     }
 
+    /// The largest displacement `|y_i − g_i|` of a fit, computed as `|α W⁻¹_ii (Q γ)_i|` from
+    /// its second derivatives `γ` rather than as the difference of `y_i` and `g_i`, which
+    /// cancels when the displacements are far below the coordinates: at the bottom of the
+    /// searches' range (`α = α_ref·e⁻²⁵`) that difference keeps only two or three digits, and
+    /// they would move with a rigid motion of the data.
+    pub(super) fn displacement_from_second(&self, fit: &Fit<D>) -> f64 {
+        let (n, ih, v) = (self.n(), &self.ih, &fit.second);
+        let mut largest = 0.0_f64;
+        for i in 0..n {
+            let qv: [f64; D] = if self.closed {
+                self.q_row_times(v, i)
+            } else if i == 0 {
+                std::array::from_fn(|c| (v[1][c] - v[0][c]) * ih[0])
+            } else if i == n - 1 {
+                std::array::from_fn(|c| (v[n - 2][c] - v[n - 1][c]) * ih[n - 2])
+            } else {
+                std::array::from_fn(|c| {
+                    (v[i - 1][c] - v[i][c]) * ih[i - 1] + (v[i + 1][c] - v[i][c]) * ih[i]
+                })
+            };
+            let scale = fit.alpha * self.d(i);
+            largest = largest.max(scale * scale * dot(&qv, &qv));
+        }
+        largest.sqrt()
+    }
+
     /// `Σ_i W⁻¹_ii q_iᵀ M⁻¹ q_i` with `M⁻¹` read by knot indices through `inv` (only pairs of
     /// unknown knots at cyclic distance ≤ 2 are asked for).
     pub(super) fn trace_term(&self, inv: impl Fn(usize, usize) -> f64) -> f64 {

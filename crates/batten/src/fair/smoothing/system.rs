@@ -5,8 +5,9 @@
 //! The operations, their order and the pivot test are those of
 //! [`crate::numeric::SymBanded::factorize`] and [`crate::numeric::SymBanded::solve_in_place`]
 //! on the same entries, so the results are the same bits; the tolerance search of `mst` solves
-//! one such system per trial (about 19 on a 200-point curve, issue #17), and the general code
-//! spent most of its time on index arithmetic, bounds checks and zeroed buffers.
+//! one such system per trial (10–14 on a 200-point curve at a noise-level tolerance, issue
+//! #17), and the general code spent most of its time on index arithmetic, bounds checks and
+//! zeroed buffers.
 
 use crate::error::{Error, Result};
 use crate::numeric::PIVOT_REL;

@@ -1,7 +1,7 @@
 //! What every trial of the smoothing spline's searches measures (see [`super`]):
 //! the largest displacement of the points, which decides the tolerance search, and the
 //! roughness, which the report's history prints. Both as the fairing report measures them,
-//! bit for bit, and both cheap, since the search measures about 19 trials (issue #17).
+//! bit for bit, and both cheap, since the search measures 5–20 trials (issue #17).
 
 /// `a · b` (in 2-D as [`crate::geom::Vec2::dot`], bit for bit).
 pub(super) fn dot<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
