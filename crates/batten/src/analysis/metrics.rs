@@ -32,6 +32,14 @@ const SAMPLES_PER_SPAN: usize = 16;
 /// that over `h_min`, count as zero.
 const NOISE_FACTOR: f64 = 64.0;
 
+/// The relative margin within which a knot's squared r''' jump has its `hypot` measured
+/// against the largest so far.
+const JUMP_SHORTLIST_MARGIN: f64 = 1e-9;
+
+/// Below this largest squared r''' jump every jump is measured (squares of subnormal size lose
+/// their relative precision).
+const JUMP_SHORTLIST_MIN: f64 = f64::MIN_POSITIVE / f64::EPSILON;
+
 /// Spans per parallel work unit of [`FairnessMetrics::of_seq`]. Fixed, so that the sums (and
 /// so the numbers) do not depend on the number of threads.
 const SPANS_PER_CHUNK: usize = 4096;
@@ -527,6 +535,8 @@ impl<'a> AnalysisSpans<'a> {
             )
         });
         let mut d_end = None;
+        // The largest squared r''' jump so far (see the jumps below).
+        let mut jump_sq = 0.0_f64;
         let mut last_left_dk = 0.0;
         let mut last_a3 = Vec2::ZERO;
         for i in spans {
@@ -559,7 +569,15 @@ impl<'a> AnalysisSpans<'a> {
             } else {
                 r.jumps.push(right_dk - last_left_dk, dk_floor);
                 let j = (a3 - last_a3) * 6.0;
-                r.max_third_jump = r.max_third_jump.max(j.length());
+                // hypot only for a jump whose squared length may hold the chunk's largest:
+                // the sum of squares is within a few ulps of the exact value, far inside the
+                // margin (the same maximum, bit for bit; tiny values measure every jump).
+                let sq = j.length_squared();
+                let floor = jump_sq * (1.0 - JUMP_SHORTLIST_MARGIN);
+                if jump_sq < JUMP_SHORTLIST_MIN || sq.is_nan() || sq >= floor {
+                    r.max_third_jump = r.max_third_jump.max(j.length());
+                    jump_sq = jump_sq.max(sq);
+                }
             }
             let d = span_derivatives(&c, t[i + 1] - t[i]);
             last_left_dk = curvature_derivative(&d);
