@@ -569,7 +569,8 @@ mod tests {
                 .map(|i| {
                     let a = turn * i as f64 / n as f64;
                     let r = 1.0 + 0.3 * (3.0 * a).sin();
-                    [r * a.cos() + noise * rng.gaussian(), r * a.sin() + 0.5 * a + noise * rng.gaussian()]
+                    let (dx, dy) = (noise * rng.gaussian(), noise * rng.gaussian());
+                    [r * a.cos() + dx, r * a.sin() + 0.5 * a + dy]
                 })
                 .collect();
             let t = chord(&y, closed);
@@ -580,7 +581,11 @@ mod tests {
             prop_assume!(top.is_ok());
             let tolerance = fraction * max_displacement(&y, &top.unwrap().values);
             prop_assume!(tolerance > 0.0);
-            let (fit, info) = Problem::new(&t, &y, None, closed).unwrap().with_terms().search_tolerance(tolerance, DEFAULT_MAX_SEARCH_STEPS).unwrap();
+            let (fit, info) = Problem::new(&t, &y, None, closed)
+                .unwrap()
+                .with_terms()
+                .search_tolerance(tolerance, DEFAULT_MAX_SEARCH_STEPS)
+                .unwrap();
             check_guarantee(&reference, tolerance, &fit, &info, &format!("seed {seed}"));
             let (old, _) = bisection(&reference, tolerance);
             prop_assert!(info.trials.len() <= old + SLACK as usize);
