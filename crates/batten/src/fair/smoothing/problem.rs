@@ -309,7 +309,7 @@ impl<'a, const D: usize> Problem<'a, D> {
         }
         let mut values = Vec::with_capacity(n);
         let mut rss = 0.0;
-        let mut push = |i: usize, qu: [f64; D]| {
+        let push = |i: usize, qu: [f64; D]| {
             let di = self.d(i);
             let yi = self.y[i];
             values.push(std::array::from_fn(|c| yi[c] - qu[c] * (b * di)));
@@ -318,25 +318,7 @@ impl<'a, const D: usize> Problem<'a, D> {
                 rss += b * b * di * dot(&qu, &qu);
             }
         };
-        if self.closed {
-            for i in 0..n {
-                push(i, self.q_row_times(&u, i));
-            }
-        } else {
-            // `q_row_times` for open curves, with the end terms apart (the same operations).
-            let ih = &self.ih;
-            push(0, std::array::from_fn(|c| (u[1][c] - u[0][c]) * ih[0]));
-            for (k, (w, h)) in u.windows(3).zip(ih.windows(2)).enumerate() {
-                let qu = std::array::from_fn(|c| {
-                    (w[0][c] - w[1][c]) * h[0] + (w[2][c] - w[1][c]) * h[1]
-                });
-                push(k + 1, qu);
-            }
-            push(
-                n - 1,
-                std::array::from_fn(|c| (u[n - 2][c] - u[n - 1][c]) * ih[n - 2]),
-            );
-        }
+        self.for_each_q_row(&u, push);
         for v in &mut u {
             for c in v.iter_mut() {
                 *c *= a;
@@ -362,29 +344,42 @@ impl<'a, const D: usize> Problem<'a, D> {
         std::array::from_fn(|c| term(im, im, c) + term(ip, i, c))
     }
 
+    /// `(Q v)_i` for every knot `i` in order, passed to `f`: [`Problem::q_row_times`], and for
+    /// open curves the same operations with the end terms apart.
+    #[inline]
+    fn for_each_q_row(&self, v: &[[f64; D]], mut f: impl FnMut(usize, [f64; D])) {
+        let n = self.n();
+        if self.closed {
+            for i in 0..n {
+                f(i, self.q_row_times(v, i));
+            }
+            return;
+        }
+        let ih = &self.ih;
+        f(0, std::array::from_fn(|c| (v[1][c] - v[0][c]) * ih[0]));
+        for (k, (w, h)) in v.windows(3).zip(ih.windows(2)).enumerate() {
+            f(
+                k + 1,
+                std::array::from_fn(|c| (w[0][c] - w[1][c]) * h[0] + (w[2][c] - w[1][c]) * h[1]),
+            );
+        }
+        f(
+            n - 1,
+            std::array::from_fn(|c| (v[n - 2][c] - v[n - 1][c]) * ih[n - 2]),
+        );
+    }
+
     /// The largest displacement `|y_i − g_i|` of a fit, computed as `|α W⁻¹_ii (Q γ)_i|` from
     /// its second derivatives `γ` rather than as the difference of `y_i` and `g_i`, which
     /// cancels when the displacements are far below the coordinates: at the bottom of the
     /// searches' range (`α = α_ref·e⁻²⁵`) that difference keeps only two or three digits, and
     /// they would move with a rigid motion of the data.
     pub(super) fn displacement_from_second(&self, fit: &Fit<D>) -> f64 {
-        let (n, ih, v) = (self.n(), &self.ih, &fit.second);
         let mut largest = 0.0_f64;
-        for i in 0..n {
-            let qv: [f64; D] = if self.closed {
-                self.q_row_times(v, i)
-            } else if i == 0 {
-                std::array::from_fn(|c| (v[1][c] - v[0][c]) * ih[0])
-            } else if i == n - 1 {
-                std::array::from_fn(|c| (v[n - 2][c] - v[n - 1][c]) * ih[n - 2])
-            } else {
-                std::array::from_fn(|c| {
-                    (v[i - 1][c] - v[i][c]) * ih[i - 1] + (v[i + 1][c] - v[i][c]) * ih[i]
-                })
-            };
+        self.for_each_q_row(&fit.second, |i, qv| {
             let scale = fit.alpha * self.d(i);
             largest = largest.max(scale * scale * dot(&qv, &qv));
-        }
+        });
         largest.sqrt()
     }
 
