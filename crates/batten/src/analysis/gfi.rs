@@ -190,9 +190,9 @@ const ARC_NODES: usize = 8;
 /// an indicator; otherwise the first and last are zero.
 pub(crate) fn lfi_from_samples(kappa: &[f64], s: &[f64], period: Option<f64>) -> Vec<f64> {
     let n = kappa.len();
-    let mut lfi = vec![0.0; n];
+    let mut out = vec![0.0; n];
     let second = |km: f64, k0: f64, kp: f64, sm: f64, s0: f64, sp: f64| {
-        2.0 * ((kp - k0) / (sp - s0) - (k0 - km) / (s0 - sm)) / (sp - sm)
+        lfi(km, k0, kp, [s0 - sm, sp - s0, sp - sm])
     };
     match period {
         Some(len) if n >= 3 => {
@@ -201,13 +201,12 @@ pub(crate) fn lfi_from_samples(kappa: &[f64], s: &[f64], period: Option<f64>) ->
                 let ip = (i + 1) % n;
                 let sm = if i == 0 { s[im] - len } else { s[im] };
                 let sp = if ip == 0 { s[0] + len } else { s[ip] };
-                let d = second(kappa[im], kappa[i], kappa[ip], sm, s[i], sp);
-                lfi[i] = d * d;
+                out[i] = second(kappa[im], kappa[i], kappa[ip], sm, s[i], sp);
             }
         }
         _ => {
             for i in 1..n.saturating_sub(1) {
-                let d = second(
+                out[i] = second(
                     kappa[i - 1],
                     kappa[i],
                     kappa[i + 1],
@@ -215,9 +214,18 @@ pub(crate) fn lfi_from_samples(kappa: &[f64], s: &[f64], period: Option<f64>) ->
                     s[i],
                     s[i + 1],
                 );
-                lfi[i] = d * d;
             }
         }
     }
-    lfi
+    out
+}
+
+/// Calì's `LFI = (κ'')²` at a sample (docs/algorithms/cali.md §4.4): the second divided
+/// difference of the curvatures `k0` before, `k1` at and `k2` after it, with `l = [l01, l12,
+/// l02]` the arc lengths from the first to the second, the second to the third and the first
+/// to the third (each as the caller measures it).
+#[inline]
+pub(crate) fn lfi(k0: f64, k1: f64, k2: f64, l: [f64; 3]) -> f64 {
+    let d = 2.0 * ((k2 - k1) / l[1] - (k1 - k0) / l[0]) / l[2];
+    d * d
 }

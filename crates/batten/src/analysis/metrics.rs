@@ -7,6 +7,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::curvature::{curvature_derivative, signed_curvature};
+use super::gfi::lfi;
 use crate::error::{Error, Result};
 use crate::geom::{Point, PointSeq, Vec2};
 use crate::numeric::GaussLegendre;
@@ -344,13 +345,10 @@ impl FairnessMetrics {
             max_third_derivative_jump,
         } = Joined::of(chunks, closed, dk_floor);
         if !closed {
-            // The end knot t_m, from the last span: its sign for the inflections, and its
-            // curvature and arc length for the GFI.
             let c = spans.coeffs(m - 1);
             let d = span_derivatives(&c, t[m] - t[m - 1]);
-            let kappa_end = signed_curvature(&d);
             let mut end = SignRuns::default();
-            end.push(kappa_end, kappa_floor);
+            end.push(signed_curvature(&d), kappa_floor);
             kappa_runs.push(end);
         }
         let inflections = count_runs(&kappa_runs, closed);
@@ -549,7 +547,7 @@ impl<'a> AnalysisSpans<'a> {
             let kappa0 = signed_curvature(&d0);
             r.kappa.push(kappa0, kappa_floor);
             if let (Some((kb, lb)), Some((kp, lp))) = (back, prev) {
-                r.gfi += lfi(kb, kp, kappa0, lb, lp);
+                r.gfi += lfi(kb, kp, kappa0, [lb, lp, lb + lp]);
             }
             // cross(s) = 6(a2×a3) s² + 6(a1×a3) s + 2(a1×a2)
             let qa = 6.0 * a2.cross(a3);
@@ -613,7 +611,7 @@ impl<'a> AnalysisSpans<'a> {
         }
         // The chunk's last knot, with the knot at the end of its last span.
         if let (Some((kb, lb)), Some((kp, lp)), Some(d)) = (back, prev, d_end) {
-            r.gfi += lfi(kb, kp, signed_curvature(&d), lb, lp);
+            r.gfi += lfi(kb, kp, signed_curvature(&d), [lb, lp, lb + lp]);
         }
         r.last_left_dk = last_left_dk;
         r.last_a3 = last_a3;
@@ -659,15 +657,6 @@ fn span_terms(
         r.variation += ws * q.dkappa_ds[j] * q.dkappa_ds[j];
     }
     r
-}
-
-/// Calì's `LFI = (κ'')²` at a knot (docs/algorithms/cali.md §4.4): the second divided
-/// difference of the curvatures `k0` before, `k1` at and `k2` after it, the spans between them
-/// of arc lengths `l0` and `l1`.
-#[inline]
-fn lfi(k0: f64, k1: f64, k2: f64, l0: f64, l1: f64) -> f64 {
-    let d = 2.0 * ((k2 - k1) / l1 - (k1 - k0) / l0) / (l0 + l1);
-    d * d
 }
 
 /// κ² and dκ/ds of a span at `N` parameters, without square roots: with `w = |r'|²`,
