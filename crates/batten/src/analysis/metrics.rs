@@ -20,10 +20,6 @@ use crate::spline::{
 /// ZERO_REL·max|v_k|`.
 pub const ZERO_REL: f64 = 1e-12;
 
-/// Samples per span for curvature extrema and the maximum curvature. The derivative of
-/// curvature of a cubic span changes sign at most a few times; 16 samples resolve it.
-const SAMPLES_PER_SPAN: usize = 16;
-
 /// Rounding-noise factor of the sign tests in [`FairnessMetrics::of_seq`]. The curvature of
 /// the spline through collinear points is pure rounding noise, of size up to about
 /// `ε·R/h_min²` (R the largest coordinate magnitude, h_min the shortest chord; measured on
@@ -98,35 +94,6 @@ impl SignRuns {
                 *m = if positive { m.max(a) } else { -(-*m).max(a) };
             }
             _ => self.runs.push(if positive { a } else { -a }),
-        }
-    }
-
-    /// [`SignRuns::push`] of `num/den` for `den > 0`, dividing only when the quotient
-    /// starts a run or raises its largest magnitude: the floor and the run's maximum are
-    /// compared as `|num|` against `floor·den` and `max·den`. (Other denominators take the
-    /// quotient as it is.)
-    #[inline]
-    fn push_ratio(&mut self, num: f64, den: f64, floor: f64) {
-        if !(den > 0.0 && den.is_finite()) {
-            self.push(num * (1.0 / den), floor);
-            return;
-        }
-        let a = num.abs();
-        if a <= floor * den {
-            return;
-        }
-        let positive = num > 0.0;
-        match self.runs.last_mut() {
-            Some(m) if (*m > 0.0) == positive => {
-                if a > m.abs() * den {
-                    let v = a / den;
-                    *m = if positive { v } else { -v };
-                }
-            }
-            _ => {
-                let v = a / den;
-                self.runs.push(if positive { v } else { -v });
-            }
         }
     }
 
@@ -224,13 +191,16 @@ pub struct FairnessMetrics {
     /// jumps of dκ/ds at the interior knots. For a function graph the jump of dκ/ds at x_i
     /// has the sign of HAN's `e_i` (docs/algorithms/han.md §1.4).
     pub vibrations: usize,
-    /// Local extrema of κ(s): the number of monotone pieces of the curvature plot minus one.
+    /// Local extrema of κ(s): the number of monotone pieces of the curvature plot minus one,
+    /// from the sign of dκ/ds sampled at each span's quadrature nodes and both one-sided
+    /// limits at its knots (docs/algorithms/README.md §0.4).
     pub curvature_extrema: usize,
     /// `∫ κ² ds`.
     pub strain_energy: f64,
     /// `∫ (dκ/ds)² ds`.
     pub variation_energy: f64,
-    /// Largest |κ| (sampled densely).
+    /// Largest |κ|, over the same samples as `curvature_extrema` (the knots and each span's
+    /// quadrature nodes).
     pub max_curvature: f64,
     /// Calì's global fairness indicator (docs/algorithms/cali.md §4.4) on the analysis curve at
     /// its knots, the data points: the sum over the knots of the squared second divided
@@ -307,9 +277,10 @@ impl FairnessMetrics {
 
         // One pass over the spans, each span's polynomial formed from the Hermite data and
         // evaluated directly (no span search, no stored coefficients): inflections from the
-        // curvature at the knots and at the vertex of each span's quadratic `r'×r''`; extrema
-        // and max |κ| from dense samples with both one-sided limits at the knots; the jumps of
-        // dκ/ds and r''' at the knots; length and energies by Gauss–Legendre quadrature. The
+        // curvature at the knots and at the vertex of each span's quadratic `r'×r''`; length and
+        // energies by Gauss–Legendre quadrature; extrema and max |κ| from the quadrature nodes'
+        // samples between both one-sided limits at the knots; the jumps of dκ/ds and r''' at
+        // the knots. The
         // spans are cut into fixed chunks measured in parallel and joined in order, so the
         // numbers do not depend on the thread count.
         static RULE: OnceLock<GaussLegendre> = OnceLock::new();
@@ -582,27 +553,21 @@ impl<'a> AnalysisSpans<'a> {
             d_end = Some(d);
             last_a3 = a3;
 
-            // Dense samples: the sign of dκ/ds and the largest κ², without square roots; the
-            // largest |κ| of the span is then evaluated as before at the sample that has it.
-            let mut at = [0.0; SAMPLES_PER_SPAN + 1];
-            for (j, s) in at.iter_mut().enumerate() {
-                *s = (t[i] + h * j as f64 / SAMPLES_PER_SPAN as f64) - t[i];
-            }
-            let q = SampleRatios::at(&c, &at);
-            // The sample of largest κ² = c12²/w³, by cross-multiplying (no division).
-            let (mut best_c12sq, mut best_w3, mut s_max) = (-1.0_f64, 1.0_f64, f64::NAN);
-            for j in 0..=SAMPLES_PER_SPAN {
-                if q.c12sq[j] * best_w3 > best_c12sq * q.w3[j] {
-                    (best_c12sq, best_w3, s_max) = (q.c12sq[j], q.w3[j], at[j]);
-                }
-                r.dk.push_ratio(q.numerator[j], q.w3[j], dk_floor);
-            }
-            if !s_max.is_nan() {
-                let k = signed_curvature(&span_derivatives(&c, s_max));
-                r.max_curvature = r.max_curvature.max(k.abs());
-            }
-
+            // The samples of dκ/ds and κ: the quadrature nodes, between both one-sided
+            // limits at the knots.
             let q = span_terms(&c, h, &nodes, &weights);
+            r.dk.push(right_dk, dk_floor);
+            let mut kappa2 = kappa0 * kappa0;
+            for j in 0..QUADRATURE_NODES {
+                r.dk.push(q.samples.dkappa_ds[j], dk_floor);
+                kappa2 = kappa2.max(q.samples.kappa2[j]);
+            }
+            r.dk.push(last_left_dk, dk_floor);
+            if i + 1 == m {
+                let k = signed_curvature(&d);
+                kappa2 = kappa2.max(k * k);
+            }
+            r.max_curvature = r.max_curvature.max(kappa2.sqrt());
             r.length += q.length;
             r.strain += q.strain;
             r.variation += q.variation;
@@ -622,8 +587,10 @@ impl<'a> AnalysisSpans<'a> {
     }
 }
 
-/// A span's length and energies by the quadrature rule of [`FairnessMetrics::of_seq`].
+/// A span's length and energies by the quadrature rule of [`FairnessMetrics::of_seq`], and
+/// the samples at the rule's nodes (which also give the extrema and the largest |κ|).
 struct SpanIntegrals {
+    samples: SampleTerms<QUADRATURE_NODES>,
     length: f64,
     strain: f64,
     variation: f64,
@@ -646,11 +613,13 @@ fn span_terms(
     }
     let q = SampleTerms::at(c, &at);
     let mut r = SpanIntegrals {
+        samples: q,
         length: 0.0,
         strain: 0.0,
         variation: 0.0,
     };
     for j in 0..QUADRATURE_NODES {
+        let q = &r.samples;
         let ws = weights[j] * half * q.w[j].sqrt();
         r.length += ws;
         r.strain += ws * q.kappa2[j];
@@ -686,32 +655,6 @@ fn products(c: &[Vec2; 4], s: f64) -> [f64; 4] {
         d1x * d3y - d1y * d3x,
         d1x * d2x + d1y * d2y,
     ]
-}
-
-/// The parts of [`SampleTerms`] before the division, for the dense samples, which only
-/// compare them: `(r'×r'')²`, the numerator of dκ/ds and `w³`.
-struct SampleRatios<const N: usize> {
-    c12sq: [f64; N],
-    numerator: [f64; N],
-    w3: [f64; N],
-}
-
-impl<const N: usize> SampleRatios<N> {
-    #[inline]
-    fn at(c: &[Vec2; 4], at: &[f64; N]) -> SampleRatios<N> {
-        let mut q = SampleRatios {
-            c12sq: [0.0; N],
-            numerator: [0.0; N],
-            w3: [0.0; N],
-        };
-        for j in 0..N {
-            let [w, c12, c13, dot] = products(c, at[j]);
-            q.c12sq[j] = c12 * c12;
-            q.numerator[j] = c13 * w - 3.0 * c12 * dot;
-            q.w3[j] = w * w * w;
-        }
-        q
-    }
 }
 
 impl<const N: usize> SampleTerms<N> {
@@ -912,13 +855,38 @@ mod tests {
                 count_sign_changes_above(&jumps, closed, dk_floor)
             );
             assert!(got.vibrations > 0 && got.inflections > 0);
+            let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+            // Extrema and max |κ|: dκ/ds and κ at each span's quadrature nodes, between the
+            // one-sided limits at its knots.
+            let gl = GaussLegendre::new(QUADRATURE_NODES);
+            let (mut dk, mut max_kappa) = (Vec::new(), 0.0_f64);
+            for i in 0..m {
+                let h = t[i + 1] - t[i];
+                let mut at = vec![t[i]];
+                at.extend(gl.nodes().iter().map(|x| t[i] + 0.5 * h * (1.0 + x)));
+                at.push(t[i + 1]);
+                for &x in &at {
+                    let d = curve.derivatives_in_span(i, x);
+                    dk.push(curvature_derivative(&d));
+                    max_kappa = max_kappa.max(signed_curvature(&d).abs());
+                }
+            }
+            assert_eq!(
+                got.curvature_extrema,
+                count_sign_changes_above(&dk, closed, dk_floor)
+            );
+            assert!(got.curvature_extrema > 0);
+            assert!(
+                rel(got.max_curvature, max_kappa) < 1e-9,
+                "{} {max_kappa}",
+                got.max_curvature
+            );
             let third = curve
                 .third_derivative_jumps()
                 .iter()
                 .fold(0.0_f64, |a, j| a.max(j.length()));
             assert_eq!(got.max_third_derivative_jump, third);
             // Energies and length by the general quadrature on the curve.
-            let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
             // The GFI: Calì's divided differences of κ at the knots over the arc lengths
             // there, cyclic when closed, summed (as `fairness_indicators` sums them).
             let mut s = vec![0.0];
