@@ -97,6 +97,35 @@ impl SignRuns {
         }
     }
 
+    /// [`SignRuns::push`] of each of `values` in order, with one test (no branch per value)
+    /// when all of them lie beyond the floor with one sign, as most of a span's samples do.
+    #[inline]
+    fn push_all<const N: usize>(&mut self, values: &[f64; N], floor: f64) {
+        let (mut lo, mut hi, mut nan) = (f64::INFINITY, f64::NEG_INFINITY, false);
+        for &v in values {
+            lo = lo.min(v);
+            hi = hi.max(v);
+            nan |= v.is_nan();
+        }
+        let last = self.runs.last_mut();
+        if !nan && lo > floor {
+            match last {
+                Some(m) if *m > 0.0 => *m = m.max(hi),
+                _ => self.runs.push(hi),
+            }
+        } else if !nan && hi < -floor {
+            match last {
+                // A NaN run is continued as `push` continues it (as negative).
+                Some(m) if *m < 0.0 || m.is_nan() => *m = m.min(lo),
+                _ => self.runs.push(lo),
+            }
+        } else {
+            for &v in values {
+                self.push(v, floor);
+            }
+        }
+    }
+
     /// The sign changes (see [`count_sign_changes`]).
     #[cfg(test)]
     fn count(&self, cyclic: bool) -> usize {
@@ -558,9 +587,9 @@ impl<'a> AnalysisSpans<'a> {
             let q = span_terms(&c, h, &nodes, &weights);
             r.dk.push(right_dk, dk_floor);
             let mut kappa2 = kappa0 * kappa0;
-            for j in 0..QUADRATURE_NODES {
-                r.dk.push(q.samples.dkappa_ds[j], dk_floor);
-                kappa2 = kappa2.max(q.samples.kappa2[j]);
+            r.dk.push_all(&q.samples.dkappa_ds, dk_floor);
+            for k2 in q.samples.kappa2 {
+                kappa2 = kappa2.max(k2);
             }
             r.dk.push(last_left_dk, dk_floor);
             if i + 1 == m {
@@ -733,6 +762,36 @@ mod tests {
             .map(|&v| if v.abs() <= floor { 0.0 } else { v })
             .collect();
         count_sign_changes(&filtered, cyclic)
+    }
+
+    #[test]
+    fn push_all_keeps_the_runs_of_push() {
+        let mut state = 7_u64;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for case in 0..3000 {
+            let floor = if case % 4 == 0 { 0.0 } else { 1e-3 };
+            let (mut one, mut all) = (SignRuns::default(), SignRuns::default());
+            for _ in 0..6 {
+                // Blocks mostly of one sign, some crossing zero or the floor, a few NaN.
+                let sign = if next() < 0.5 { -1.0 } else { 1.0 };
+                let block: [f64; 4] = std::array::from_fn(|_| match next() {
+                    x if x < 0.02 => f64::NAN,
+                    x if x < 0.1 => 0.0,
+                    x if x < 0.2 => -sign * next(),
+                    x if x < 0.3 => sign * 1e-4,
+                    _ => sign * (0.01 + next()),
+                });
+                block.iter().for_each(|&v| one.push(v, floor));
+                all.push_all(&block, floor);
+            }
+            let bits = |r: &SignRuns| r.runs.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&one), bits(&all), "case {case}");
+        }
     }
 
     #[test]

@@ -10,9 +10,6 @@ use crate::error::Result;
 use crate::geom::SpaceSeq;
 use crate::numeric::GaussLegendre;
 
-/// Samples per span for the extrema and maxima, as for planar curves.
-const SAMPLES_PER_SPAN: usize = 16;
-
 /// Rounding-noise factor of the sign tests, as for planar curves: κ below
 /// `NOISE_FACTOR·ε·R/h_min²` (R the largest coordinate magnitude, h_min the shortest chord)
 /// counts as zero, dκ/ds below that over `h_min` too; the triple product `(r'×r'')·r'''`
@@ -240,33 +237,19 @@ impl SpaceMetrics {
     }
 }
 
-/// Gather span `i` of `curve` into `r`: dense samples (both ends) for the maxima and the
-/// sign runs, Gauss–Legendre nodes for length and energies.
+/// Gather span `i` of `curve` into `r`: the maxima and the sign runs from samples at the
+/// Gauss–Legendre nodes between both one-sided limits at the knots, as for planar curves
+/// (docs/algorithms/README.md §0.4); length and energies by the same nodes.
 #[inline]
 fn span_sums(curve: &SpaceCubic, i: usize, gl: &GaussLegendre, floors: Floors, r: &mut Sums) {
     let t = curve.knots();
     let (t0, h) = (t[i], t[i + 1] - t[i]);
-    for j in 0..=SAMPLES_PER_SPAN {
-        let d = curve.derivatives_in_span(i, t0 + h * j as f64 / SAMPLES_PER_SPAN as f64);
-        let f = Frenet::of(&d);
-        r.max_curvature = r.max_curvature.max(f.kappa);
-        if f.kappa <= floors.kappa {
-            // No osculating plane: neither d|κ|/ds nor τ has a meaningful sign.
-            continue;
-        }
-        r.dk.push(f.dkappa_ds, floors.dkappa);
-        if floors.triple_counts(&f, &d) {
-            let tau = f.torsion();
-            r.max_torsion = r.max_torsion.max(tau.abs());
-            r.tau.push(tau, 0.0);
-            r.dtau.push(f.torsion_rate(), 0.0);
-        }
-    }
     let half = 0.5 * h;
     let mid = t0 + half;
+    sample(r, &curve.derivatives_in_span(i, t0), floors);
     for (x, w) in gl.nodes().iter().zip(gl.weights()) {
         let d = curve.derivatives_in_span(i, mid + half * x);
-        let f = Frenet::of(&d);
+        let f = sample(r, &d, floors);
         let ws = w * half * f.speed;
         r.length += ws;
         r.strain += ws * f.kappa * f.kappa;
@@ -276,6 +259,26 @@ fn span_sums(curve: &SpaceCubic, i: usize, gl: &GaussLegendre, floors: Floors, r
             r.torsion += ws * tau * tau;
         }
     }
+    sample(r, &curve.derivatives_in_span(i, t[i + 1]), floors);
+}
+
+/// One sample of the maxima and the sign runs; its Frenet quantities.
+#[inline]
+fn sample(r: &mut Sums, d: &SpaceDerivatives, floors: Floors) -> Frenet {
+    let f = Frenet::of(d);
+    r.max_curvature = r.max_curvature.max(f.kappa);
+    if f.kappa <= floors.kappa {
+        // No osculating plane: neither d|κ|/ds nor τ has a meaningful sign.
+        return f;
+    }
+    r.dk.push(f.dkappa_ds, floors.dkappa);
+    if floors.triple_counts(&f, d) {
+        let tau = f.torsion();
+        r.max_torsion = r.max_torsion.max(tau.abs());
+        r.tau.push(tau, 0.0);
+        r.dtau.push(f.torsion_rate(), 0.0);
+    }
+    f
 }
 
 #[cfg(test)]
