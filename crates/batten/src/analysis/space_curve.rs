@@ -210,7 +210,7 @@ impl SpaceCubic {
         let tangents = if closed {
             periodic_tangents(&dt, &slope)?
         } else {
-            open_tangents(&t, &dt, &slope, Ends::NotAKnot)?
+            open_tangents(&t, |i| dt[i], |i| slope[i], Ends::NotAKnot)?
         };
         drop(slope);
         let coeffs: Vec<[Xyz; 4]> = (0..spans)
