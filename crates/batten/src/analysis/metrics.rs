@@ -101,10 +101,12 @@ impl SignRuns {
     /// when all of them lie beyond the floor with one sign, as most of a span's samples do.
     #[inline]
     fn push_all<const N: usize>(&mut self, values: &[f64; N], floor: f64) {
+        // Plain comparisons (a NaN leaves `lo` and `hi` as they were, and takes the slow
+        // path below), not `f64::min`/`max`, whose NaN rules cost several instructions each.
         let (mut lo, mut hi, mut nan) = (f64::INFINITY, f64::NEG_INFINITY, false);
         for &v in values {
-            lo = lo.min(v);
-            hi = hi.max(v);
+            lo = if v < lo { v } else { lo };
+            hi = if v > hi { v } else { hi };
             nan |= v.is_nan();
         }
         let last = self.runs.last_mut();
@@ -586,11 +588,14 @@ impl<'a> AnalysisSpans<'a> {
             // limits at the knots.
             let q = span_terms(&c, h, &nodes, &weights);
             r.dk.push(right_dk, dk_floor);
-            let mut kappa2 = kappa0 * kappa0;
             r.dk.push_all(&q.samples.dkappa_ds, dk_floor);
+            // The nodes' largest κ² by comparisons from 0 (a NaN is skipped, as `f64::max`
+            // skips it), then joined with the knot's.
+            let mut nodes_kappa2 = 0.0_f64;
             for k2 in q.samples.kappa2 {
-                kappa2 = kappa2.max(k2);
+                nodes_kappa2 = if k2 > nodes_kappa2 { k2 } else { nodes_kappa2 };
             }
+            let mut kappa2 = (kappa0 * kappa0).max(nodes_kappa2);
             r.dk.push(last_left_dk, dk_floor);
             if i + 1 == m {
                 let k = signed_curvature(&d);
