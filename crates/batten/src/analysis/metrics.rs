@@ -524,6 +524,8 @@ impl<'a> AnalysisSpans<'a> {
         // curvatures at the knots and the spans' lengths: (κ, length) of the knot and span
         // two before the current one and of those just before it. The chunk's first knot
         // needs the span before the chunk (a closed curve's last span before its first).
+        // The samples at the quadrature nodes of the span at hand.
+        let mut samples = SampleTerms::new();
         let mut back: Option<(f64, f64)> = None;
         let mut prev: Option<(f64, f64)> = (first > 0 || self.is_closed()).then(|| {
             let j = (first + m - 1) % m;
@@ -531,7 +533,7 @@ impl<'a> AnalysisSpans<'a> {
             let kappa = signed_curvature(&span_derivatives(&c, 0.0));
             (
                 kappa,
-                span_terms(&c, t[j + 1] - t[j], &nodes, &weights).length,
+                span_terms(&c, t[j + 1] - t[j], (&nodes, &weights), &mut samples).length,
             )
         });
         let mut d_end = None;
@@ -586,13 +588,13 @@ impl<'a> AnalysisSpans<'a> {
 
             // The samples of dκ/ds and κ: the quadrature nodes, between both one-sided
             // limits at the knots.
-            let q = span_terms(&c, h, &nodes, &weights);
+            let q = span_terms(&c, h, (&nodes, &weights), &mut samples);
             r.dk.push(right_dk, dk_floor);
-            r.dk.push_all(&q.samples.dkappa_ds, dk_floor);
+            r.dk.push_all(&samples.dkappa_ds, dk_floor);
             // The nodes' largest κ² by comparisons from 0 (a NaN is skipped, as `f64::max`
             // skips it), then joined with the knot's.
             let mut nodes_kappa2 = 0.0_f64;
-            for k2 in q.samples.kappa2 {
+            for k2 in samples.kappa2 {
                 nodes_kappa2 = if k2 > nodes_kappa2 { k2 } else { nodes_kappa2 };
             }
             let mut kappa2 = (kappa0 * kappa0).max(nodes_kappa2);
@@ -621,23 +623,22 @@ impl<'a> AnalysisSpans<'a> {
     }
 }
 
-/// A span's length and energies by the quadrature rule of [`FairnessMetrics::of_seq`], and
-/// the samples at the rule's nodes (which also give the extrema and the largest |κ|).
+/// A span's length and energies by the quadrature rule of [`FairnessMetrics::of_seq`].
 struct SpanIntegrals {
-    samples: SampleTerms<QUADRATURE_NODES>,
     length: f64,
     strain: f64,
     variation: f64,
 }
 
 /// [`SpanIntegrals`] of the span with coefficients `c` over `[0, h]` (the rule's nodes and
-/// weights on `[−1, 1]`).
+/// weights on `[−1, 1]`), with the samples at the nodes left in `q` (they also give the
+/// extrema and the largest |κ|).
 #[inline]
 fn span_terms(
     c: &[Vec2; 4],
     h: f64,
-    nodes: &[f64; QUADRATURE_NODES],
-    weights: &[f64; QUADRATURE_NODES],
+    (nodes, weights): (&[f64; QUADRATURE_NODES], &[f64; QUADRATURE_NODES]),
+    q: &mut SampleTerms<QUADRATURE_NODES>,
 ) -> SpanIntegrals {
     let half = 0.5 * h;
     let mut at = [0.0; QUADRATURE_NODES];
@@ -645,15 +646,13 @@ fn span_terms(
         // The node's offset from the span's start.
         *s = half + half * x;
     }
-    let q = SampleTerms::at(c, &at);
+    q.fill(c, &at);
     let mut r = SpanIntegrals {
-        samples: q,
         length: 0.0,
         strain: 0.0,
         variation: 0.0,
     };
     for j in 0..QUADRATURE_NODES {
-        let q = &r.samples;
         let ws = weights[j] * half * q.w[j].sqrt();
         r.length += ws;
         r.strain += ws * q.kappa2[j];
@@ -692,21 +691,26 @@ fn products(c: &[Vec2; 4], s: f64) -> [f64; 4] {
 }
 
 impl<const N: usize> SampleTerms<N> {
-    #[inline]
-    fn at(c: &[Vec2; 4], at: &[f64; N]) -> SampleTerms<N> {
-        let mut q = SampleTerms {
+    /// Zeros, to be filled by [`SampleTerms::fill`] (one buffer for every span of a chunk, not
+    /// a new one a span, which cost a fill with zeros and a copy each).
+    fn new() -> SampleTerms<N> {
+        SampleTerms {
             w: [0.0; N],
             kappa2: [0.0; N],
             dkappa_ds: [0.0; N],
-        };
+        }
+    }
+
+    /// The terms of span coefficients `c` at the parameters `at`.
+    #[inline]
+    fn fill(&mut self, c: &[Vec2; 4], at: &[f64; N]) {
         for j in 0..N {
             let [w, c12, c13, dot] = products(c, at[j]);
             let inv = 1.0 / (w * w * w);
-            q.w[j] = w;
-            q.kappa2[j] = c12 * c12 * inv;
-            q.dkappa_ds[j] = (c13 * w - 3.0 * c12 * dot) * inv;
+            self.w[j] = w;
+            self.kappa2[j] = c12 * c12 * inv;
+            self.dkappa_ds[j] = (c13 * w - 3.0 * c12 * dot) * inv;
         }
-        q
     }
 }
 
