@@ -307,18 +307,22 @@ impl<'a, const D: usize> Problem<'a, D> {
             mat.factorize()?;
             mat.solve_in_place(&mut u[1..n - 1]);
         }
-        let mut values = Vec::with_capacity(n);
+        // g_i = y_i − b D_i (Qu)_i, subtracted in place from a copy of the data (no growing
+        // vector: pushing cost a capacity check and more a value).
+        let mut values = self.y.to_vec();
         let mut rss = 0.0;
-        let push = |i: usize, qu: [f64; D]| {
+        let subtract = |i: usize, qu: [f64; D]| {
             let di = self.d(i);
-            let yi = self.y[i];
-            values.push(std::array::from_fn(|c| yi[c] - qu[c] * (b * di)));
+            let g = &mut values[i];
+            for c in 0..D {
+                g[c] -= qu[c] * (b * di);
+            }
             if gcv {
                 // w_i |y_i − g_i|² = b² D_i |(Qu)_i|², exact even where g_i ≈ y_i.
                 rss += b * b * di * dot(&qu, &qu);
             }
         };
-        self.for_each_q_row(&u, push);
+        self.for_each_q_row(&u, subtract);
         for v in &mut u {
             for c in v.iter_mut() {
                 *c *= a;
