@@ -30,21 +30,20 @@ impl Penta {
     /// [`crate::numeric::SymBanded::add`] would store them in a zero matrix.
     pub(crate) fn from_columns(columns: impl ExactSizeIterator<Item = [f64; 3]>) -> Penta {
         let m = columns.len();
+        // Row 0 has no entry left of the diagonal, row 1 one; the last columns' entries
+        // below the matrix are written past its end and cut off. (Written by index into
+        // zeros, not pushed: a push costs a capacity check and more.)
         let mut a = Penta {
-            diag: Vec::with_capacity(m),
-            sub1: Vec::with_capacity(m),
-            sub2: Vec::with_capacity(m),
+            diag: vec![0.0; m],
+            sub1: vec![0.0; m + 1],
+            sub2: vec![0.0; m + 2],
         };
-        // Row 0 has no entry left of the diagonal, row 1 one.
-        a.sub1.extend_from_slice(&[0.0; 1][..m.min(1)]);
-        a.sub2.extend_from_slice(&[0.0; 2][..m.min(2)]);
-        for [d0, d1, d2] in columns {
+        for (j, [d0, d1, d2]) in columns.enumerate().take(m) {
             // `0.0 + v`, as an addition into a zero matrix stores it (−0 becomes +0).
-            a.diag.push(0.0 + d0);
-            a.sub1.push(0.0 + d1);
-            a.sub2.push(0.0 + d2);
+            a.diag[j] = 0.0 + d0;
+            a.sub1[j + 1] = 0.0 + d1;
+            a.sub2[j + 2] = 0.0 + d2;
         }
-        // The last columns' entries below the matrix.
         a.sub1.truncate(m);
         a.sub2.truncate(m);
         a
