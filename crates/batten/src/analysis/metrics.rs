@@ -277,7 +277,7 @@ impl FairnessMetrics {
         if s == 1.0 {
             return Self::measure(seq);
         }
-        let unit = seq.with_points(crate::geom::scale_points(seq.points(), 1.0 / s))?;
+        let unit = seq.scaled_to_unit(1.0 / s);
         Ok(Self::measure(&unit)?.rescaled(s))
     }
 

@@ -527,7 +527,7 @@ fn in_unit(seq: &PointSeq, s: f64) -> Result<PointSeq> {
     if s == 1.0 {
         return Ok(seq.clone());
     }
-    seq.with_points(crate::geom::scale_points(seq.points(), 1.0 / s))
+    Ok(seq.scaled_to_unit(1.0 / s))
 }
 
 /// The common part of every report: the clean-curve guard, displacements, metrics after,

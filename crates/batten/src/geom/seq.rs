@@ -94,6 +94,21 @@ impl PointSeq {
     pub fn with_points(&self, points: Vec<Point>) -> Result<PointSeq> {
         PointSeq::new(points, self.closed)
     }
+
+    /// The sequence with its coordinates multiplied by `factor`, the power of two that brings
+    /// the bounding box's larger side near 1 (`1/`[`crate::geom::unit_scale`]), without
+    /// validating it again: such a scaling is exact but for coordinates that become
+    /// subnormal, far below the near-duplicate limit, so a valid sequence stays valid (the
+    /// measurements scale every report's curves this way, twice a fair; validating them again
+    /// was a few per cent of a small fair).
+    pub(crate) fn scaled_to_unit(&self, factor: f64) -> PointSeq {
+        let scaled = PointSeq {
+            points: crate::geom::scale_points(&self.points, factor),
+            closed: self.closed,
+        };
+        debug_assert!(validate_points(&scaled.points, scaled.closed, Self::MIN_POINTS).is_ok());
+        scaled
+    }
 }
 
 /// Check that `points` has at least `min` entries, all finite, with no zero-length chord.
