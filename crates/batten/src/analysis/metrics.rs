@@ -775,13 +775,8 @@ mod tests {
 
     #[test]
     fn push_all_keeps_the_runs_of_push() {
-        let mut state = 7_u64;
-        let mut next = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::test_rng::Rng::new(7);
+        let mut next = move || rng.uniform();
         for case in 0..3000 {
             let floor = if case % 4 == 0 { 0.0 } else { 1e-3 };
             let (mut one, mut all) = (SignRuns::default(), SignRuns::default());
