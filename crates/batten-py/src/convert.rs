@@ -37,6 +37,15 @@ pub fn points_any(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Points> {
     let shape = array.shape().to_vec();
     let view = array.try_readonly()?;
     let view = view.as_array();
+    // An array in C order (what numpy makes by default) is read as one slice; others (Fortran
+    // order, strided views) row by row.
+    if let (Some(flat), [_, 2]) = (view.as_slice(), shape.as_slice()) {
+        return Ok(Points::Planar(
+            flat.chunks_exact(2)
+                .map(|xy| Point::new(xy[0], xy[1]))
+                .collect(),
+        ));
+    }
     match shape.as_slice() {
         [_, 2] => Ok(Points::Planar(
             view.outer_iter()
