@@ -131,9 +131,10 @@ pub struct SpaceMetrics {
     pub points: usize,
     /// Whether the curve is closed.
     pub closed: bool,
-    /// Largest κ (sampled densely).
+    /// Largest κ, over the samples of the planar metrics: each span's quadrature nodes,
+    /// between the one-sided limits at its knots (docs/algorithms/README.md §0.4).
     pub max_curvature: f64,
-    /// Local extrema of κ(s).
+    /// Local extrema of κ(s), from the sign of d|κ|/ds at the same samples.
     pub curvature_extrema: usize,
     /// Largest |τ| where the torsion is defined (κ above the rounding floor).
     pub max_torsion: f64,
