@@ -379,33 +379,30 @@ pub(crate) fn open_tangents<T: Linear + Div<f64, Output = T>>(
             }
         }
     };
-    let diag = |i: usize| match end {
-        _ if i > 0 && i < n - 1 => 2.0 * (dt(i - 1) + dt(i)),
-        Ends::Natural => 2.0,
-        Ends::Clamped(..) => 1.0,
-        Ends::NotAKnot if i == 0 => dt(1),
-        Ends::NotAKnot => dt(n - 3),
-    };
-    let scale = (0..n)
-        .fold(0.0_f64, |m, i| m.max(diag(i).abs()))
-        .max(f64::MIN_POSITIVE);
-    let singular = || Error::Singular("zero pivot in tridiagonal solve".into());
+    // The pivot test of `solve_tridiagonal` (a pivot within `PIVOT_REL` of the largest
+    // diagonal entry, or a non-finite one past the first row), made once the sweep has seen
+    // every diagonal entry: a failed test ends in the same error, and a passed one leaves the
+    // same values.
+    let mut scale = 0.0_f64;
+    let (mut smallest_pivot, mut finite) = (f64::INFINITY, true);
     let mut c = vec![0.0; n];
     let mut x = Vec::with_capacity(n);
     let (_, mut beta, mut sup, rhs) = row(0);
-    if beta.abs() <= PIVOT_REL * scale {
-        return Err(singular());
-    }
+    scale = scale.max(beta.abs());
+    smallest_pivot = smallest_pivot.min(beta.abs());
     x.push(rhs * (1.0 / beta));
     for i in 1..n {
         let (sub, d, next_sup, rhs) = row(i);
+        scale = scale.max(d.abs());
         c[i - 1] = sup / beta;
         beta = d - sub * c[i - 1];
-        if beta.abs() <= PIVOT_REL * scale || !beta.is_finite() {
-            return Err(singular());
-        }
+        smallest_pivot = smallest_pivot.min(beta.abs());
+        finite &= beta.is_finite();
         x.push((rhs - x[i - 1] * sub) * (1.0 / beta));
         sup = next_sup;
+    }
+    if !(finite && smallest_pivot > PIVOT_REL * scale.max(f64::MIN_POSITIVE)) {
+        return Err(Error::Singular("zero pivot in tridiagonal solve".into()));
     }
     for i in (0..n - 1).rev() {
         x[i] = x[i] - x[i + 1] * c[i];
