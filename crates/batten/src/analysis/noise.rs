@@ -29,6 +29,7 @@
 //! generic over the dimension, and the planar results are those it always gave.
 
 use crate::geom::Point;
+use crate::numeric::{PARALLEL_FROM, map_indices};
 
 /// The MAD-to-σ factor for Gaussian noise.
 pub const MAD_TO_SIGMA: f64 = 1.482_6;
@@ -204,7 +205,7 @@ fn off_tangent_median<const D: usize>(pts: &[[f64; D]], closed: bool) -> (f64, f
         }))
     };
     // The two medians side by side on long curves (a median is one thread's work).
-    let (rough, spacing) = if count >= PARALLEL_VALUES {
+    let (rough, spacing) = if count >= PARALLEL_FROM {
         rayon::join(rough, spacing)
     } else {
         (rough(), spacing())
@@ -231,27 +232,13 @@ fn off_tangent_median<const D: usize>(pts: &[[f64; D]], closed: bool) -> (f64, f
         (len > 0.0).then(|| off_axis(&differences[i], &chord) / len)
     };
     let mut normal_parts = Vec::with_capacity(count);
-    if count >= PARALLEL_VALUES {
+    if count >= PARALLEL_FROM {
         use rayon::prelude::*;
         normal_parts.par_extend((0..count).into_par_iter().filter_map(part));
     } else {
         normal_parts.extend((0..count).filter_map(part));
     }
     (median(normal_parts), gain)
-}
-
-/// From this many values on, [`map_indices`] runs in parallel (the medians' inputs of a
-/// 10⁶-point curve took a tenth of a second on one thread).
-const PARALLEL_VALUES: usize = 1 << 16;
-
-/// `f(0), …, f(count − 1)` in order, in parallel from [`PARALLEL_VALUES`] on.
-fn map_indices<T: Send>(count: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
-    use rayon::prelude::*;
-    if count >= PARALLEL_VALUES {
-        (0..count).into_par_iter().map(f).collect()
-    } else {
-        (0..count).map(f).collect()
-    }
 }
 
 /// The median of `v` (the upper one for an even count; 0 when empty).

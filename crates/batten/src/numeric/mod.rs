@@ -7,6 +7,7 @@ mod banded;
 mod cyclic_banded;
 mod minimize;
 mod nelder_mead;
+mod parallel;
 mod quadrature;
 mod tridiagonal;
 
@@ -18,6 +19,7 @@ pub use banded::SymBanded;
 pub use cyclic_banded::CyclicSymBanded;
 pub use minimize::{Minimum, minimize_brent, minimize_golden};
 pub use nelder_mead::{NelderMeadParams, SimplexMinimum, minimize_nelder_mead};
+pub(crate) use parallel::{PARALLEL_FROM, map_indices};
 pub use quadrature::GaussLegendre;
 pub use tridiagonal::{solve_cyclic_tridiagonal, solve_tridiagonal};
 

@@ -9,7 +9,7 @@ use crate::geom::{Point, Vec2};
 use std::ops::Div;
 
 use super::knots::break_span;
-use crate::numeric::{Linear, PIVOT_REL, solve_cyclic_tridiagonal};
+use crate::numeric::{Linear, PIVOT_REL, map_indices, solve_cyclic_tridiagonal};
 
 /// How parameter values are assigned to a point sequence (docs/algorithms/README.md §0.2).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -48,19 +48,9 @@ pub fn parameters(points: &[Point], kind: Parametrization, closed: bool) -> Resu
     }
     let n = points.len();
     let m = if closed { n } else { n.saturating_sub(1) };
-    let chord = |i: usize| (points[(i + 1) % n] - points[i]).length();
     // The chord lengths (hypot, the costly part) in parallel for long sequences, then summed
     // in order: the same bits with any number of threads.
-    let lengths: Vec<f64> = if m >= PARALLEL_CHORDS {
-        use rayon::prelude::*;
-        (0..m)
-            .into_par_iter()
-            .with_min_len(4096)
-            .map(chord)
-            .collect()
-    } else {
-        (0..m).map(chord).collect()
-    };
+    let lengths = map_indices(m, |i| (points[(i + 1) % n] - points[i]).length());
     let mut t = Vec::with_capacity(m + 1);
     t.push(0.0);
     for (i, &d) in lengths.iter().enumerate() {
@@ -76,9 +66,6 @@ pub fn parameters(points: &[Point], kind: Parametrization, closed: bool) -> Resu
     }
     Ok(t)
 }
-
-/// [`parameters`] measures the chords of at least this many in parallel.
-const PARALLEL_CHORDS: usize = 1 << 16;
 
 /// A piecewise cubic Hermite curve through `P_0..P_m` at parameters `t_0 < … < t_m`; each span
 /// is the cubic with the end positions and first derivatives of its knots (KP eq 6).
