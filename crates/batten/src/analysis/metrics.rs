@@ -311,9 +311,8 @@ impl FairnessMetrics {
         // curvature at the knots and at the vertex of each span's quadratic `r'×r''`; length and
         // energies by Gauss–Legendre quadrature; extrema and max |κ| from the quadrature nodes'
         // samples between both one-sided limits at the knots; the jumps of dκ/ds and r''' at
-        // the knots. The
-        // spans are cut into fixed chunks measured in parallel and joined in order, so the
-        // numbers do not depend on the thread count.
+        // the knots. The spans are cut into fixed chunks measured in parallel and joined in
+        // order, so the numbers do not depend on the thread count.
         static RULE: OnceLock<GaussLegendre> = OnceLock::new();
         // Computed once per process (Newton on the Legendre polynomial: 4 % of a 200-point
         // measurement when it was computed every time).

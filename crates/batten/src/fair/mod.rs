@@ -369,7 +369,7 @@ pub fn fair(name: &str, input: &PointSeq, options: &FairOptions) -> Result<Faire
 pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) -> Result<Faired> {
     check_options(m, input.is_closed(), options)?;
     let unit_scale = crate::geom::unit_scale(input.points());
-    let before = FairnessMetrics::of_seq(&in_unit(input, unit_scale)?)?;
+    let before = FairnessMetrics::of_seq(&in_unit(input, unit_scale))?;
     let start = Instant::now();
     let sigma = noise_sigma(input.points(), input.is_closed());
     let (resolved, source) =
@@ -510,7 +510,7 @@ pub fn fair_curve(name: &str, curve: &BSplineCurve, options: &FairOptions) -> Re
     };
     let (input, outcome) = run?;
     let unit_scale = crate::geom::unit_scale(input.points());
-    let before = FairnessMetrics::of_seq(&in_unit(&input, unit_scale)?)?;
+    let before = FairnessMetrics::of_seq(&in_unit(&input, unit_scale))?;
     finish(
         m,
         (&input, Some(curve)),
@@ -523,11 +523,11 @@ pub fn fair_curve(name: &str, curve: &BSplineCurve, options: &FairOptions) -> Re
 }
 
 /// `seq` divided by `s` (exact: `s` is a power of two).
-fn in_unit(seq: &PointSeq, s: f64) -> Result<PointSeq> {
+fn in_unit(seq: &PointSeq, s: f64) -> PointSeq {
     if s == 1.0 {
-        return Ok(seq.clone());
+        return seq.clone();
     }
-    Ok(seq.scaled_to_unit(1.0 / s))
+    seq.scaled_to_unit(1.0 / s)
 }
 
 /// The common part of every report: the clean-curve guard, displacements, metrics after,
@@ -551,7 +551,7 @@ fn finish(
         });
     }
     let mut faired = input.with_points(outcome.points.clone())?;
-    let mut after = FairnessMetrics::of_seq(&in_unit(&faired, unit_scale)?)?;
+    let mut after = FairnessMetrics::of_seq(&in_unit(&faired, unit_scale))?;
     if options.keep_clean
         && m.keeps_clean()
         && let Some(why) = guard::worse(&before, &after)
