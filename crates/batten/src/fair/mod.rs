@@ -61,6 +61,7 @@ mod sapidis_farin;
 mod smoothing;
 mod space;
 
+use std::borrow::Cow;
 use std::time::Instant;
 
 pub use band::{Band, auto_k as band_tolerance_factor};
@@ -523,11 +524,11 @@ pub fn fair_curve(name: &str, curve: &BSplineCurve, options: &FairOptions) -> Re
 }
 
 /// `seq` divided by `s` (exact: `s` is a power of two).
-fn in_unit(seq: &PointSeq, s: f64) -> PointSeq {
+fn in_unit(seq: &PointSeq, s: f64) -> Cow<'_, PointSeq> {
     if s == 1.0 {
-        return seq.clone();
+        return Cow::Borrowed(seq);
     }
-    seq.scaled_to_unit(1.0 / s)
+    Cow::Owned(seq.scaled_to_unit(1.0 / s))
 }
 
 /// The common part of every report: the clean-curve guard, displacements, metrics after,
