@@ -298,8 +298,10 @@ impl<'a, const D: usize> Penalized<'a, D> {
     /// The data weight `μ` of the discrepancy principle: the smallest `μ` (in the bracket)
     /// whose minimiser's mean squared residual is at most `target`, or whose energy reaches
     /// `cap` (`E(s)` is the energy of the reference, the passes' result); the smallest `μ`
-    /// of the bracket when that one meets the target already. `None` when the reference
-    /// already meets the target (nothing to debias) or the smallest `μ` reaches the cap.
+    /// of the bracket when that one meets the target already, or when the reference does
+    /// (the local weights then look for what the mean residual does not see: a flattening
+    /// confined to a few points, as at free ends). `None` when the smallest `μ` reaches the
+    /// cap.
     pub(super) fn discrepancy_weight(
         &self,
         anchor_energy: f64,
@@ -308,14 +310,10 @@ impl<'a, const D: usize> Penalized<'a, D> {
     ) -> Result<Option<f64>> {
         let n = self.points() as f64;
         let reference_residual = self.mean_square_residual(&self.fixed);
-        if target.is_nan()
-            || target <= 0.0
-            || reference_residual <= target
-            || cap.is_nan()
-            || cap <= anchor_energy
-        {
+        if target.is_nan() || target <= 0.0 || cap.is_nan() || cap <= anchor_energy {
             return Ok(None);
         }
+        let met = reference_residual <= target;
         // In units of the mean spacing a data weight μ smooths over about μ^(-1/6) points:
         // from twice the curve down to a single point, and no lower than rounding of `2A`
         // leaves meaningful.
@@ -333,6 +331,11 @@ impl<'a, const D: usize> Penalized<'a, D> {
                 .then(|| self.mean_square_residual(&y) > target),
             Err(_) => Some(true),
         };
+        // The reference meets the target: nothing to bisect, but the local weights may
+        // still find a biased stretch.
+        if met {
+            return Ok(more_data(lo).map(|_| lo.exp()));
+        }
         match more_data(lo) {
             None => return Ok(None),
             // The smoothest weight that rounding leaves meaningful meets the target already:
