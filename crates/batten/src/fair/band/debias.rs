@@ -32,6 +32,9 @@ pub(super) const ENERGY_CAP: f64 = 4.0;
 const LOCAL_ROUNDS: usize = 6;
 /// The factor by which a round raises the data weight around a biased window.
 const LOCAL_FACTOR: f64 = 4.0;
+/// The raised weights are smoothed: each point's logarithm of its weight is averaged over
+/// this many of its smoothing lengths (see [`smooth_log_weights`]).
+const WEIGHT_SMOOTHING: f64 = 3.0;
 
 /// Bisection steps on `log μ` (the bracket spans 6·ln(2n) in `ln μ`, under 90 for 10⁶ points; 24 halvings
 /// leave `μ` within 1e-5 of itself, far below what the residual sees).
@@ -364,8 +367,10 @@ impl<'a, const D: usize> Penalized<'a, D> {
     /// smoother fed only noise is high-frequency, so its windowed means stay well under that
     /// threshold; a feature the energy flattens leaves a one-signed residual as long as the
     /// feature, and is found. Stops when no window is significant, after [`LOCAL_ROUNDS`], or
-    /// before a round whose energy would pass `cap`. Returns the weights and the number of
-    /// points whose weight was raised.
+    /// before a round whose energy would pass `cap`. The raised weights, a factor 4 apart
+    /// across a window's edge, are then smoothed ([`smooth_log_weights`]; kept unsmoothed if
+    /// the smoothed ones would pass `cap`). Returns the weights and the number of points
+    /// whose weight was raised.
     pub(super) fn local_weights(
         &self,
         mu: f64,
@@ -430,9 +435,56 @@ impl<'a, const D: usize> Penalized<'a, D> {
             weights = trial;
             y = trial_y;
         }
+        if weights.iter().any(|w| *w > mu) {
+            let smooth =
+                smooth_log_weights(&weights, self.unit, self.energy.closed, WEIGHT_SMOOTHING);
+            if let Ok(y) = self.minimiser(|i| smooth[i], false)
+                && self.energy_at(&y, anchor_energy) <= cap
+            {
+                weights = smooth;
+            }
+        }
         let raised = weights.iter().filter(|w| **w > mu).count();
         Ok((weights, raised))
     }
+}
+
+/// The data weights with each point's logarithm of its weight averaged over a window of
+/// `lengths` of its own smoothing lengths (`(w_i/unit)^(−1/6)` points, as
+/// [`Penalized::local_weights`] measures them), cyclic when `closed`, cut at the ends when
+/// open; prefix sums, O(n). Equal weights are left equal (to rounding).
+///
+/// Why: the raising multiplies the weights around a biased window by 4, and the steps of the
+/// smoothing length at the window's edges leave waves in the curvature a few smoothing
+/// lengths long (a noisy cubic's curvature peak, 1000 points at 0.1 % noise: −2.85 then
+/// −4.26 where the truth goes −3.31, −3.89). Averaged over 3 smoothing lengths, the median curvature error on
+/// both splits of the quality benchmark fell by about 2 % (tuning 0.202 → 0.193, test 0.204
+/// → 0.196), better on about three curves for every one worse.
+fn smooth_log_weights(weights: &[f64], unit: f64, closed: bool, lengths: f64) -> Vec<f64> {
+    let n = weights.len();
+    if n == 0 {
+        return Vec::new();
+    }
+    // The logarithms three times over, so that cyclic windows are plain ranges.
+    let mut prefix = Vec::with_capacity(3 * n + 1);
+    prefix.push(0.0);
+    let mut acc = 0.0;
+    for k in 0..3 * n {
+        acc += weights[k % n].ln();
+        prefix.push(acc);
+    }
+    (0..n)
+        .map(|i| {
+            let length = lengths * (weights[i] / unit).powf(-1.0 / 6.0);
+            let half = ((0.5 * length).round() as usize).clamp(1, n / 2);
+            let (lo, hi) = if closed {
+                (n + i - half, n + i + half + 1)
+            } else {
+                (n + i.saturating_sub(half), n + (i + half + 1).min(n))
+            };
+            ((prefix[hi] - prefix[lo]) / (hi - lo) as f64).exp()
+        })
+        .collect()
 }
 
 /// One knot span's share of `Σ_i |(B y)_i − c_i|²` over the free points on it, as a
@@ -640,6 +692,38 @@ impl Marks {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Equal weights stay equal; a step of the weights becomes a monotone ramp between its two
+    /// levels, as wide as the windows (3 smoothing lengths of each side's weight), open and
+    /// closed; a closed curve's weights are smoothed across its seam.
+    #[test]
+    fn smoothing_the_log_weights_ramps_a_step() {
+        let unit = 1.0;
+        let flat = vec![1e-6; 50];
+        for closed in [false, true] {
+            for w in smooth_log_weights(&flat, unit, closed, WEIGHT_SMOOTHING) {
+                assert!((w / 1e-6 - 1.0).abs() < 1e-12, "{w}");
+            }
+        }
+        // Smoothing lengths (w/unit)^(-1/6): 10 points at 1e-6, 5 at 6.4e-5 (4³ higher).
+        let (low, high) = (1e-6, 6.4e-5);
+        let step: Vec<f64> = (0..200).map(|i| if i < 100 { low } else { high }).collect();
+        let open = smooth_log_weights(&step, unit, false, WEIGHT_SMOOTHING);
+        for pair in open.windows(2) {
+            assert!(pair[1] >= pair[0] * (1.0 - 1e-12), "not monotone: {pair:?}");
+        }
+        assert!(
+            open.iter()
+                .all(|w| *w >= low * (1.0 - 1e-12) && *w <= high * (1.0 + 1e-12))
+        );
+        // Half widths: 15 points on the low side, 8 on the high side (3 × 10 / 2, 3 × 5 / 2).
+        assert!((open[84] / low - 1.0).abs() < 1e-12 && open[85] > low * 1.01);
+        assert!((open[108] / high - 1.0).abs() < 1e-12 && open[107] < high * 0.99);
+        let closed = smooth_log_weights(&step, unit, true, WEIGHT_SMOOTHING);
+        // Across the seam (point 199, high, next to point 0, low) the ramp goes the other way.
+        assert!(closed[0] > low * 1.01 && closed[199] < high * 0.99);
+        assert_eq!(&closed[20..80], &open[20..80]);
+    }
 
     /// The window about `i` by brute force: indices `i − half ..= i + half`, wrapped when
     /// closed, cut at the ends when open.
