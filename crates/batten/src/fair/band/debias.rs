@@ -465,12 +465,14 @@ fn smooth_log_weights(weights: &[f64], unit: f64, closed: bool, lengths: f64) ->
     if n == 0 {
         return Vec::new();
     }
-    // The logarithms three times over, so that cyclic windows are plain ranges.
+    // Prefix sums of the logarithms three times over, so that cyclic windows are plain
+    // ranges (each logarithm taken once).
+    let logs: Vec<f64> = weights.iter().map(|w| w.ln()).collect();
     let mut prefix = Vec::with_capacity(3 * n + 1);
     prefix.push(0.0);
     let mut acc = 0.0;
     for k in 0..3 * n {
-        acc += weights[k % n].ln();
+        acc += logs[k % n];
         prefix.push(acc);
     }
     (0..n)
