@@ -85,7 +85,7 @@ mod tests {
                 .map(|p| (p.kind, p.default))
         };
         let number = |d: &str| Some((ParamType::Number, d.to_string()));
-        assert_eq!(kind("band", "speed"), number("0"));
+        assert_eq!(kind("band", "speed"), number("0.0005"));
         assert_eq!(kind("band", "local"), number("2"));
         assert_eq!(kind("kuragano", "gradient_fraction"), number("1"));
         assert_eq!(kind("han", "max_turn"), number("pi/2"));

@@ -14,8 +14,11 @@ use super::energy::Metric;
 pub(super) const DEFAULT_PASSES: usize = 3;
 /// Default significance of a biased window in the debiasing stage.
 pub(super) const DEFAULT_LOCAL: f64 = 2.0;
-/// Default weight of the speed term of the minimum-variation energy.
-pub(super) const DEFAULT_SPEED: f64 = 0.0;
+/// Default weight of the speed term of the minimum-variation energy: the value with the
+/// lowest curvature error per spurious inflection on the quality benchmark's tuning split
+/// (0.0003 / 0.0005 / 0.001: median 0.187 / 0.185 / 0.185 with 172 / 171 / 188 spurious
+/// inflections; 0: 0.193 with 155). See `docs/algorithms/band.md`, the speed term.
+pub(super) const DEFAULT_SPEED: f64 = 0.0005;
 /// Default weight of the full jerk inside the minimum-variation energy.
 pub(super) const DEFAULT_EPS: f64 = 0.02;
 /// Default residual target of the debiasing stage, in noise standard deviations.
@@ -62,7 +65,7 @@ pub(super) const SPEED: Param<Number<f64>> = Param {
         min: 0.0,
         max: 1e6,
     },
-    doc: "weight of the speed term inside the min-variation energy (the tangential second difference: keeps points from crowding where the curvature peaks); [0, 1e6]",
+    doc: "weight of the speed term inside the min-variation energy (the tangential second difference: keeps points from crowding where the curvature peaks; the point form: dense curves take the spline form, which has no speed term); [0, 1e6]",
 };
 
 /// The debiasing stage's residual target ([`DEFAULT_FIT`]).
