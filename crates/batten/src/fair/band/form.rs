@@ -4,7 +4,7 @@
 use super::design::Design;
 use super::energy::{self, Energy, Metric};
 use super::solver::Solution;
-use super::spline::{Layout, feasible_fit};
+use super::spline::{Layout, Span, feasible_fit};
 use crate::error::Result;
 
 /// Knot spans per tolerance of curve length in the spline form: a span every tolerance
@@ -34,7 +34,7 @@ enum Kind {
     /// The unknowns are control points: the knot spans' energy coefficients and the feasible
     /// start, flat, in the solver's units.
     Spline {
-        spans: Vec<(usize, [f64; 4], f64)>,
+        spans: Vec<Span>,
         fit: Vec<f64>,
         unit: f64,
     },

@@ -51,11 +51,25 @@ const FIT_SMOOTHING_SPANS: f64 = 0.5;
 pub(super) struct Layout {
     /// The map from control points to points.
     pub design: Design,
-    /// For every knot span: its first control point, the coefficients of `C'''/6` on its four
-    /// control points, and its length.
-    pub spans: Vec<(usize, [f64; 4], f64)>,
+    /// For every knot span: its first control point, the coefficients of `C'''/6` and `C''`
+    /// on its four control points, and its length.
+    pub spans: Vec<Span>,
     /// The length of a knot span, in the points' parameter units.
     pub span_length: f64,
+}
+
+/// One knot span of a cubic B-spline, for the energy: `C'''` is constant on it and `C''`
+/// linear.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Span {
+    /// Its first control point (of four).
+    pub first: usize,
+    /// The coefficients of `C'''/6` on its four control points.
+    pub third: [f64; 4],
+    /// The coefficients of `C''` at its start and at its end.
+    pub second: [[f64; 4]; 2],
+    /// Its length in the parameter.
+    pub len: f64,
 }
 
 impl Layout {
@@ -108,7 +122,12 @@ impl Layout {
                     diff(q1[j + 1], q1[j], 2.0 / (u[s + j + 4] - u[s + j + 2]))
                 });
                 let len = u[s + 4] - u[s + 3];
-                (s, diff(q2[1], q2[0], 1.0 / (6.0 * len)), len)
+                Span {
+                    first: s,
+                    third: diff(q2[1], q2[0], 1.0 / (6.0 * len)),
+                    second: q2,
+                    len,
+                }
             })
             .collect();
         Layout {
@@ -140,8 +159,15 @@ impl Layout {
             ]);
         }
         let c = 1.0 / (6.0 * h * h * h);
+        // `C''` of the uniform cubic basis at the span's ends (u = 0 and 1), over h².
+        let d = 1.0 / (h * h);
         let spans_coef = (0..spans)
-            .map(|s| (s, [-c, 3.0 * c, -3.0 * c, c], h))
+            .map(|s| Span {
+                first: s,
+                third: [-c, 3.0 * c, -3.0 * c, c],
+                second: [[d, -2.0 * d, d, 0.0], [0.0, d, -2.0 * d, d]],
+                len: h,
+            })
             .collect();
         Layout {
             design: Design::Spline(SplineMap {
@@ -305,12 +331,25 @@ mod tests {
             let lin: f64 = (0..4).map(|k| b[k] * greville[map.first[i] + k]).sum();
             assert!((lin - ti).abs() < 1e-9 * end, "{lin} {ti}");
         }
-        for (s, coef, _) in &open.spans {
-            let f = |g: &dyn Fn(f64) -> f64| -> f64 {
-                (0..4).map(|k| coef[k] * g(greville[s + k])).sum()
+        for span in &open.spans {
+            let f = |coef: &[f64; 4], g: &dyn Fn(f64) -> f64| -> f64 {
+                (0..4).map(|k| coef[k] * g(greville[span.first + k])).sum()
             };
-            assert!(f(&|_| 1.0).abs() < 1e-12);
-            assert!(f(&|x| x).abs() < 1e-12);
+            assert!(f(&span.third, &|_| 1.0).abs() < 1e-12);
+            assert!(f(&span.third, &|x| x).abs() < 1e-12);
+            // C'' of a line (control points at the Greville abscissae) is 0, and of the
+            // parabola x²/2 (control points from its blossom, the mean of the pairwise
+            // products of each control point's three knots, halved) 1, at both ends.
+            let j = span.first;
+            let blossom: [f64; 4] = std::array::from_fn(|k| {
+                let (a, b, c) = (u[j + k + 1], u[j + k + 2], u[j + k + 3]);
+                (a * b + a * c + b * c) / 6.0
+            });
+            for second in &span.second {
+                assert!(f(second, &|x| x).abs() < 1e-9);
+                let parabola: f64 = (0..4).map(|k| second[k] * blossom[k]).sum();
+                assert!((parabola - 1.0).abs() < 1e-9, "{parabola}");
+            }
         }
         let closed = Layout::new(&t, true, 80.0, 16);
         let Design::Spline(map) = &closed.design else {
@@ -323,7 +362,8 @@ mod tests {
             closed
                 .spans
                 .iter()
-                .all(|(_, c, _)| c.iter().sum::<f64>().abs() < 1e-9)
+                .all(|s| s.third.iter().sum::<f64>().abs() < 1e-9
+                    && s.second.iter().all(|c| c.iter().sum::<f64>().abs() < 1e-9))
         );
     }
 }
