@@ -263,6 +263,55 @@ fn a_creeping_dual_residual_ends_the_run() {
     assert!(r.tolerance_met);
 }
 
+/// Exact samples with `--tolerance auto`: the noise estimate's differences are the curve's
+/// own shape, so nothing moves and a note says why (the bundled `sine-truth.csv` used to lose
+/// its end inflections and come out with 1.6 times its curvature error against the truth).
+/// A tolerance given, the test does not apply.
+#[test]
+fn exact_samples_have_no_noise_for_the_automatic_tolerance() {
+    for name in [
+        "sine-truth.csv",
+        "clothoid-truth.csv",
+        "strophoid-truth.csv",
+    ] {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../examples/data")
+            .join(name);
+        let input = batten::io::read_points(&path, &batten::io::ReadOptions::default())
+            .expect("example")
+            .seq;
+        let out = fair::fair("band", &input, &FairOptions::default()).unwrap();
+        let r = &out.report;
+        assert_eq!(r.status, FairStatus::NoChange, "{name}: {:?}", r.notes);
+        assert_eq!(r.tolerance_source, Some(ToleranceSource::Auto));
+        assert!(
+            r.notes.iter().any(|n| n.contains("found no noise")),
+            "{name}: {:?}",
+            r.notes
+        );
+        assert_eq!(out.points.as_slice(), input.points(), "{name}");
+        // A tolerance given is the user's: the test does not apply (the result may still
+        // be the input, where the clean-curve guard finds it worse).
+        let given = FairOptions::default().with_tolerance(0.01 * input.bbox().diagonal());
+        let faired = fair::fair("band", &input, &given).unwrap();
+        assert!(
+            faired
+                .report
+                .notes
+                .iter()
+                .all(|n| !n.contains("found no noise")),
+            "{name}"
+        );
+        if name == "sine-truth.csv" {
+            assert_eq!(faired.report.status, FairStatus::Converged);
+        }
+    }
+    // Noisy points are faired as before.
+    let noisy = noisy(200, 0.01, 3, false);
+    let out = fair::fair("band", &noisy, &FairOptions::default()).unwrap();
+    assert_eq!(out.report.status, FairStatus::Converged);
+}
+
 #[test]
 fn takes_k_noise_estimates_when_no_tolerance_is_given() {
     let input = noisy(300, 0.03, 11, false);

@@ -307,6 +307,26 @@ fn band_brings_a_noisy_helix_close_to_the_truth() {
     assert!(rms(&m.points, &exact) < before);
 }
 
+/// An exact helix with `--tolerance auto`: no noise, nothing moves, a note says why.
+#[test]
+fn an_exact_helix_has_no_noise_for_the_automatic_tolerance() {
+    let exact = SpaceSeq::new(truth(400, false), false).unwrap();
+    let out = fair_space("band", &exact, &FairOptions::default()).unwrap();
+    assert_eq!(
+        out.report.status,
+        FairStatus::NoChange,
+        "{:?}",
+        out.report.notes
+    );
+    assert!(
+        out.report
+            .notes
+            .iter()
+            .any(|n| n.contains("found no noise"))
+    );
+    assert_eq!(out.points.as_slice(), exact.points());
+}
+
 /// Coordinates ×1e-150 and ×1e150: the run works (on coordinates divided by a power of two)
 /// and gives the unscaled result scaled.
 #[test]

@@ -12,7 +12,8 @@
 //! - fairness measures: [`FairnessMetrics`] (on [`analysis_curve`], with [`ZERO_REL`],
 //!   [`count_sign_changes`] and [`sgn0`] for its sign tests), [`displacement`]
 //!   ([`Displacement`]), Calì's [`fairness_indicators`] ([`FairnessIndicators`]), the noise
-//!   estimates [`noise_sigma`] and [`noise_sigma_space`];
+//!   estimates [`noise_sigma`] and [`noise_sigma_space`], and [`difference_correlation`], which
+//!   tells noise from a clean curve's own differences;
 //! - space curves: [`SpaceCubic`], [`SpaceSample`], [`SpaceDerivatives`], [`SpaceMetrics`];
 //! - Kuragano & Yamaguchi's evaluation (which polynomial ρ(s) a curve follows best, paper
 //!   §4–§5, `batten evaluate`): [`evaluate_roc_fairness`] of a [`RocDesign`] under
@@ -42,7 +43,9 @@ pub use metrics::{
     Displacement, FairnessMetrics, ZERO_REL, analysis_curve, count_sign_changes, displacement, sgn0,
 };
 pub(crate) use noise::is_planar;
-pub use noise::{MAD_TO_SIGMA, MEDIAN_LENGTH_2D_TO_SIGMA, noise_sigma, noise_sigma_space};
+pub use noise::{
+    MAD_TO_SIGMA, MEDIAN_LENGTH_2D_TO_SIGMA, difference_correlation, noise_sigma, noise_sigma_space,
+};
 pub use roc_fairness::{
     DEFAULT_METHOD_GRADIENT_FRACTION, DegreeResult, Design as RocDesign, DesignEnds,
     Evaluation as RocEvaluation, KuraganoOptions, MAX_SAMPLES as ROC_MAX_SAMPLES,

@@ -162,74 +162,114 @@ fn off_axis<const D: usize>(d: &[f64; D], c: &[f64; D]) -> f64 {
     acc.unwrap_or(0.0)
 }
 
+/// The differences of [`noise_sigma`] and the chords that give their normals: the order's
+/// coefficients' noise gain `√C(2k, k)`, the order `k`, every difference `Δᵏp_i` (`count` of
+/// them) and the chord's reach `m` beyond the difference's points. `None` below four points.
+struct Differences<const D: usize> {
+    gain: f64,
+    k: usize,
+    differences: Vec<[f64; D]>,
+    reach: usize,
+}
+
+impl<const D: usize> Differences<D> {
+    fn of(pts: &[[f64; D]], closed: bool) -> Option<Differences<D>> {
+        let n = pts.len();
+        if n < 4 {
+            return None;
+        }
+        let (coef, gain) = if n >= FIFTH_ORDER_POINTS {
+            FIFTH
+        } else {
+            THIRD
+        };
+        let k = coef.len() - 1;
+        let count = if closed { n } else { n - k };
+        let difference = |i: usize| -> [f64; D] {
+            let mut d = [0.0; D];
+            for (j, c) in coef.iter().enumerate() {
+                let p = at(pts, closed, (i + j) as isize);
+                for x in 0..D {
+                    d[x] += c * p[x];
+                }
+            }
+            d
+        };
+        // Each difference once (the rough scale and the normal parts both read it).
+        let differences: Vec<[f64; D]> = map_indices(count, difference);
+        let rough =
+            || median(map_indices(count, |i| length(&differences[i]))) * MAD_TO_SIGMA / gain;
+        let spacing = || {
+            median(map_indices(if closed { n } else { n - 1 }, |i| {
+                length(&sub(
+                    at(pts, closed, i as isize + 1),
+                    at(pts, closed, i as isize),
+                ))
+            }))
+        };
+        // The two medians side by side on long curves (a median is one thread's work).
+        let (rough, spacing) = if count >= PARALLEL_FROM {
+            rayon::join(rough, spacing)
+        } else {
+            (rough(), spacing())
+        };
+        let reach = if spacing > 0.0 {
+            let m = (NORMAL_CHORD_NOISE_SPANS * rough / spacing).ceil();
+            if m.is_finite() {
+                (m as usize).min(n / 8)
+            } else {
+                0
+            }
+        } else {
+            0
+        };
+        Some(Differences {
+            gain,
+            k,
+            differences,
+            reach,
+        })
+    }
+
+    /// The chord that gives difference `i` its normal.
+    fn chord(&self, pts: &[[f64; D]], closed: bool, i: usize) -> [f64; D] {
+        sub(
+            at(pts, closed, (i + self.k + self.reach) as isize),
+            at(pts, closed, i as isize - self.reach as isize),
+        )
+    }
+}
+
+/// Point `i` of `pts`, wrapped when closed, clamped to the ends when open.
+fn at<const D: usize>(pts: &[[f64; D]], closed: bool, i: isize) -> [f64; D] {
+    let n = pts.len() as isize;
+    if closed {
+        pts[i.rem_euclid(n) as usize]
+    } else {
+        pts[i.clamp(0, n - 1) as usize]
+    }
+}
+
+fn sub<const D: usize>(a: [f64; D], b: [f64; D]) -> [f64; D] {
+    std::array::from_fn(|x| a[x] - b[x])
+}
+
 /// The median length of the differences' parts off the local chord, in any dimension, and
 /// the noise gain `√C(2k, k)` of the differences used (`(0, 1)` for fewer than four points).
 /// σ̂ is the median times the factor that turns the median length of one such part into σ,
 /// over the gain.
 fn off_tangent_median<const D: usize>(pts: &[[f64; D]], closed: bool) -> (f64, f64) {
-    let n = pts.len();
-    if n < 4 {
+    let Some(diffs) = Differences::of(pts, closed) else {
         return (0.0, 1.0);
-    }
-    let (coef, gain) = if n >= FIFTH_ORDER_POINTS {
-        FIFTH
-    } else {
-        THIRD
     };
-    let k = coef.len() - 1;
-    let count = if closed { n } else { n - k };
-    let at = |i: isize| -> [f64; D] {
-        if closed {
-            pts[i.rem_euclid(n as isize) as usize]
-        } else {
-            pts[i.clamp(0, n as isize - 1) as usize]
-        }
-    };
-    let sub = |a: [f64; D], b: [f64; D]| -> [f64; D] { std::array::from_fn(|x| a[x] - b[x]) };
-    let difference = |i: usize| -> [f64; D] {
-        let mut d = [0.0; D];
-        for (j, c) in coef.iter().enumerate() {
-            let p = at((i + j) as isize);
-            for x in 0..D {
-                d[x] += c * p[x];
-            }
-        }
-        d
-    };
-    // Each difference once (the rough scale and the normal parts both read it).
-    let differences: Vec<[f64; D]> = map_indices(count, difference);
-    let rough = || median(map_indices(count, |i| length(&differences[i]))) * MAD_TO_SIGMA / gain;
-    let spacing = || {
-        median(map_indices(if closed { n } else { n - 1 }, |i| {
-            length(&sub(at(i as isize + 1), at(i as isize)))
-        }))
-    };
-    // The two medians side by side on long curves (a median is one thread's work).
-    let (rough, spacing) = if count >= PARALLEL_FROM {
-        rayon::join(rough, spacing)
-    } else {
-        (rough(), spacing())
-    };
-    let reach = if spacing > 0.0 {
-        let m = (NORMAL_CHORD_NOISE_SPANS * rough / spacing).ceil();
-        if m.is_finite() {
-            (m as usize).min(n / 8)
-        } else {
-            0
-        }
-    } else {
-        0
-    };
+    let count = diffs.differences.len();
     // The differences without a chord are skipped; the vector is reserved whole (collected
     // from a filter, it grew by doubling: a tenth of a 200-point fair's instructions went to
     // growing the vectors here).
     let part = |i: usize| {
-        let chord = sub(
-            at((i + k + reach) as isize),
-            at(i as isize - reach as isize),
-        );
+        let chord = diffs.chord(pts, closed, i);
         let len = length(&chord);
-        (len > 0.0).then(|| off_axis(&differences[i], &chord) / len)
+        (len > 0.0).then(|| off_axis(&diffs.differences[i], &chord) / len)
     };
     let mut normal_parts = Vec::with_capacity(count);
     if count >= PARALLEL_FROM {
@@ -238,7 +278,45 @@ fn off_tangent_median<const D: usize>(pts: &[[f64; D]], closed: bool) -> (f64, f
     } else {
         normal_parts.extend((0..count).filter_map(part));
     }
-    (median(normal_parts), gain)
+    (median(normal_parts), diffs.gain)
+}
+
+/// The lag-one correlation of the differences' parts off the local chord (those [`noise_sigma`]
+/// takes the median of, as vectors): `Σ ⟨e_i, e_{i+1}⟩ / Σ |e_i|²`, cyclic when closed.
+/// Independent noise gives `−k/(k + 1)` (−5/6 for the fifth differences: consecutive
+/// differences share five points with alternating binomial weights); a smooth curve's own
+/// differences change slowly from one to the next and give nearly 1. So a value near 1 says
+/// that σ̂ measures the curve's shape, not noise. `None` below four points or when every part
+/// vanishes (points on a line, rounding-free samples of a low-degree polynomial).
+pub fn difference_correlation<const D: usize>(pts: &[[f64; D]], closed: bool) -> Option<f64> {
+    let diffs = Differences::of(pts, closed)?;
+    let count = diffs.differences.len();
+    let part = |i: usize| -> [f64; D] {
+        let c = diffs.chord(pts, closed, i);
+        let cc: f64 = c.iter().map(|v| v * v).sum();
+        let d = &diffs.differences[i];
+        if !(cc > 0.0 && cc.is_finite()) {
+            return [0.0; D];
+        }
+        let along = d.iter().zip(&c).map(|(a, b)| a * b).sum::<f64>() / cc;
+        std::array::from_fn(|x| d[x] - along * c[x])
+    };
+    let parts: Vec<[f64; D]> = map_indices(count, part);
+    // In units of the largest part, so that no square under- or overflows.
+    let top = parts
+        .iter()
+        .flat_map(|e| e.iter().map(|v| v.abs()))
+        .fold(0.0_f64, f64::max);
+    if !(top > 0.0 && top.is_finite()) {
+        return None;
+    }
+    let dot = |a: &[f64; D], b: &[f64; D]| (0..D).map(|x| (a[x] / top) * (b[x] / top)).sum::<f64>();
+    let pairs = if closed { count } else { count - 1 };
+    let lagged: f64 = (0..pairs)
+        .map(|i| dot(&parts[i], &parts[(i + 1) % count]))
+        .sum();
+    let total: f64 = parts.iter().map(|e| dot(e, e)).sum();
+    (total > 0.0).then(|| lagged / total)
 }
 
 /// The median of `v` (the upper one for an even count; 0 when empty).
@@ -307,6 +385,72 @@ mod tests {
             .collect();
         let est = noise_sigma(&noisy, false);
         assert!((est / 0.01 - 1.0).abs() < 0.35, "σ̂ = {est}");
+    }
+
+    /// Independent noise gives the fifth differences a lag-one correlation of −5/6, a clean
+    /// curve's own differences nearly 1; noise on a curve sits in between, nearer the noise.
+    #[test]
+    fn the_differences_correlation_tells_noise_from_a_clean_curve() {
+        let xy = |p: &[Point]| -> Vec<[f64; 2]> { p.iter().map(|q| [q.x, q.y]).collect() };
+        // Noise about a line, open and closed (a circle): −5/6 to sampling error.
+        let (ex, ey) = (gaussian(3, 4000), gaussian(4, 4000));
+        let line: Vec<[f64; 2]> = (0..4000)
+            .map(|i| [i as f64 * 0.01 + 1e-3 * ex[i], 1e-3 * ey[i]])
+            .collect();
+        let r = difference_correlation(&line, false).unwrap();
+        assert!((r + 5.0 / 6.0).abs() < 0.03, "{r}");
+        let circle: Vec<[f64; 2]> = (0..4000)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / 4000.0;
+                [a.cos() + 1e-3 * ex[i], a.sin() + 1e-3 * ey[i]]
+            })
+            .collect();
+        let r = difference_correlation(&circle, true).unwrap();
+        assert!((r + 5.0 / 6.0).abs() < 0.03, "{r}");
+        // The bundled sine's truth, 30 exact points: its differences are its shape.
+        let sine: Vec<Point> = (0..30)
+            .map(|i| {
+                let x = 4.0 * std::f64::consts::PI * i as f64 / 29.0;
+                Point::new(x, (0.5 * x).sin())
+            })
+            .collect();
+        let r = difference_correlation(&xy(&sine), false).unwrap();
+        assert!(r > 0.85, "{r}");
+        // With noise of 0.001 in y (a thirtieth of its noisy twin's), noise again.
+        let e = gaussian(5, 30);
+        let noisy: Vec<Point> = sine
+            .iter()
+            .zip(&e)
+            .map(|(p, e)| Point::new(p.x, p.y + 1e-3 * e))
+            .collect();
+        let r = difference_correlation(&xy(&noisy), false).unwrap();
+        assert!(r < 0.0, "{r}");
+        // In space: a clean helix, and the same with noise.
+        let helix: Vec<[f64; 3]> = (0..200)
+            .map(|i| {
+                let t = 0.06 * i as f64;
+                [t.cos(), t.sin(), 0.15 * t]
+            })
+            .collect();
+        let r = difference_correlation(&helix, false).unwrap();
+        assert!(r > 0.85, "{r}");
+        let ez = gaussian(6, 200);
+        let noisy: Vec<[f64; 3]> = helix
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                [
+                    p[0] + 1e-3 * ex[i],
+                    p[1] + 1e-3 * ey[i],
+                    p[2] + 1e-3 * ez[i],
+                ]
+            })
+            .collect();
+        assert!(difference_correlation(&noisy, false).unwrap() < 0.0);
+        // Nothing to correlate: too few points, or a line.
+        assert!(difference_correlation(&[[0.0, 0.0]; 3], false).is_none());
+        let straight: Vec<[f64; 2]> = (0..20).map(|i| [i as f64, 2.0 * i as f64]).collect();
+        assert!(difference_correlation(&straight, false).is_none());
     }
 
     #[test]

@@ -138,7 +138,9 @@ pub fn fair_space(name: &str, input: &SpaceSeq, options: &FairOptions) -> Result
     let (resolved, source) =
         super::resolve_tolerance(m, options, sigma, input.scale(), input.len())?;
     let options = &resolved;
-    let outcome = if let Some(note) = super::all_held(options, input.len(), closed) {
+    let unchanged = super::all_held(options, input.len(), closed)
+        .or_else(|| super::no_noise(source, input.points(), closed));
+    let outcome = if let Some(note) = unchanged {
         SpaceOutcome {
             points: input.points().to_vec(),
             status: FairStatus::NoChange,
