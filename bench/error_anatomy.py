@@ -20,20 +20,15 @@ Open CASCADE it also prints the degree and the number of poles of its curve for 
 Not part of CI; needs numpy, scipy and (for the peer) cadquery-ocp, as `quality.py` does.
 """
 
-import argparse
-import importlib.util
 import os
-import sys
 import tempfile
 
 import numpy as np
 
+from one_case import Case, arguments
+from one_case import quality as q
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-_spec = importlib.util.spec_from_file_location("quality", os.path.join(HERE, "quality.py"))
-q = importlib.util.module_from_spec(_spec)
-_argv, sys.argv = sys.argv, [sys.argv[0]]
-_spec.loader.exec_module(q)
-sys.argv = _argv
 
 BANDS = [(1, 4), (4, 16), (16, 64), (64, None)]
 
@@ -57,34 +52,17 @@ def by_wavelength(e):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("family")
-    ap.add_argument("n", type=int)
-    ap.add_argument("noise", type=float)
-    ap.add_argument("--seeds", type=int, default=20)
-    ap.add_argument("--split", default="test", choices=["test", "tune"])
+    ap = arguments(__doc__, seeds=20)
     ap.add_argument("--method", default="band", help="a batten method spec, as quality.py's --methods")
     ap.add_argument("--no-occt", action="store_true")
     a = ap.parse_args()
-
-    families = [f(a.split) for f in q.FAMILIES]
-    names = [f.name for f in families]
-    if a.family not in names:
-        raise SystemExit(f"unknown family {a.family!r}: one of {', '.join(names)}")
-    fi = names.index(a.family)
-    fam = families[fi]
-    tau = np.linspace(fam.t0, fam.t1, a.n)
-    truth = fam.points(tau)
-    k_true = fam.kappa(tau)
-    k_rms = float(np.sqrt(np.mean(k_true**2)))
-    sigma = a.noise * float(np.hypot(*(truth.max(0) - truth.min(0))))
+    case = Case(a.family, a.n, a.noise, a.split)
     m = max(1, a.n // 10)
     tools = {a.method: []} | ({} if a.no_occt else {"occt": []})
     shape = None
     with tempfile.TemporaryDirectory() as tmp:
         for seed in range(1, a.seeds + 1):
-            rng = np.random.default_rng([seed, fi, a.n, 7])
-            noisy = truth + rng.normal(0.0, sigma, size=truth.shape)
+            noisy = case.noisy(seed)
             pts, status, _, _, msg = q.run_batten(a.method, noisy, "auto", tmp, 120)
             if pts is None:
                 raise SystemExit(f"seed {seed}: batten {status}: {msg}")
@@ -100,7 +78,7 @@ def main():
           + " / ".join(f"{lo}–{hi}" if hi else f"> {lo}" for lo, hi in BANDS) + " |")
     print("|---|---|---|---|---|")
     for tool, results in tools.items():
-        err = np.array([(q.curvature_at_points(p) - k_true) / k_rms for p in results])
+        err = np.array([(q.curvature_at_points(p) - case.k_true) / case.k_rms for p in results])
         whole = np.sqrt(np.mean(err**2, axis=1))
         bias, spread = err.mean(0), err.std(0)
         ends = np.r_[0:m, a.n - m:a.n]

@@ -14,22 +14,14 @@ its local weights: what no setting of those can beat by much. Not part of CI; ne
 scipy and cadquery-ocp, as `quality.py` does.
 """
 
-import argparse
-import importlib.util
 import math
-import os
-import sys
 
 import numpy as np
 from scipy.sparse import csr_matrix, diags, identity
 from scipy.sparse.linalg import splu
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-_spec = importlib.util.spec_from_file_location("quality", os.path.join(HERE, "quality.py"))
-q = importlib.util.module_from_spec(_spec)
-_argv, sys.argv = sys.argv, [sys.argv[0]]
-_spec.loader.exec_module(q)
-sys.argv = _argv
+from one_case import Case, arguments
+from one_case import quality as q
 
 
 def penalty(t, order):
@@ -67,42 +59,24 @@ def smooth(p, energy, fit, sigma):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("family")
-    ap.add_argument("n", type=int)
-    ap.add_argument("noise", type=float)
+    ap = arguments(__doc__, seeds=10)
     ap.add_argument("--orders", default="2,3,5")
     ap.add_argument("--fits", default="1.0,1.05,1.1,1.25")
-    ap.add_argument("--seeds", type=int, default=10)
-    ap.add_argument("--split", default="test", choices=["test", "tune"])
     a = ap.parse_args()
-    families = [f(a.split) for f in q.FAMILIES]
-    names = [f.name for f in families]
-    if a.family not in names:
-        raise SystemExit(f"unknown family {a.family!r}: one of {', '.join(names)}")
-    fi = names.index(a.family)
-    fam = families[fi]
-    tau = np.linspace(fam.t0, fam.t1, a.n)
-    truth = fam.points(tau)
-    k_true = fam.kappa(tau)
-    k_rms = float(np.sqrt(np.mean(k_true**2)))
-    grid, s = fam.arclength()
-    arc = np.interp(tau, grid, s)
-    sigma = a.noise * float(np.hypot(*(truth.max(0) - truth.min(0))))
+    case = Case(a.family, a.n, a.noise, a.split)
+    grid, s = case.family.arclength()
+    arc = np.interp(case.tau, grid, s)
     orders = [int(x) for x in a.orders.split(",")]
     fits = [float(x) for x in a.fits.split(",")]
     energies = {k: penalty(arc, k) for k in orders}
     errors = {}
     for seed in range(1, a.seeds + 1):
-        rng = np.random.default_rng([seed, fi, a.n, 7])
-        noisy = truth + rng.normal(0.0, sigma, size=truth.shape)
+        noisy = case.noisy(seed)
         for k in orders:
             for fit in fits:
-                r = smooth(noisy, energies[k], fit, sigma)
-                e = q.curvature_at_points(r) - k_true
-                errors.setdefault((k, fit), []).append(np.sqrt(np.mean(e**2)) / k_rms)
+                errors.setdefault((k, fit), []).append(case.kappa_error(smooth(noisy, energies[k], fit, case.sigma)))
         o = q.peer_occt(noisy, q.noise_sigma(noisy))
-        errors.setdefault(("occt", None), []).append(np.sqrt(np.mean((q.curvature_at_points(o) - k_true) ** 2)) / k_rms)
+        errors.setdefault(("occt", None), []).append(case.kappa_error(o))
     print(f"{a.family} ({a.split} split), n = {a.n}, noise {a.noise:g} of the diagonal, {a.seeds} seeds: "
           "median κ err by penalty order and fit")
     print("| order | " + " | ".join(f"fit {f:g}" for f in fits) + " |")
