@@ -291,15 +291,18 @@ fn off_tangent_median<const D: usize>(pts: &[[f64; D]], closed: bool) -> (f64, f
 pub fn difference_correlation<const D: usize>(pts: &[[f64; D]], closed: bool) -> Option<f64> {
     let diffs = Differences::of(pts, closed)?;
     let count = diffs.differences.len();
+    // The unit chord by `hypot`, so that coordinates of any size neither over- nor
+    // underflow.
     let part = |i: usize| -> [f64; D] {
         let c = diffs.chord(pts, closed, i);
-        let cc: f64 = c.iter().map(|v| v * v).sum();
+        let len = length(&c);
         let d = &diffs.differences[i];
-        if !(cc > 0.0 && cc.is_finite()) {
+        if !(len > 0.0 && len.is_finite()) {
             return [0.0; D];
         }
-        let along = d.iter().zip(&c).map(|(a, b)| a * b).sum::<f64>() / cc;
-        std::array::from_fn(|x| d[x] - along * c[x])
+        let u: [f64; D] = std::array::from_fn(|x| c[x] / len);
+        let along = d.iter().zip(&u).map(|(a, b)| a * b).sum::<f64>();
+        std::array::from_fn(|x| d[x] - along * u[x])
     };
     let parts: Vec<[f64; D]> = map_indices(count, part);
     // In units of the largest part, so that no square under- or overflows.
@@ -414,8 +417,8 @@ mod tests {
                 Point::new(x, (0.5 * x).sin())
             })
             .collect();
-        let r = difference_correlation(&xy(&sine), false).unwrap();
-        assert!(r > 0.85, "{r}");
+        let sine_r = difference_correlation(&xy(&sine), false).unwrap();
+        assert!(sine_r > 0.85, "{sine_r}");
         // With noise of 0.001 in y (a thirtieth of its noisy twin's), noise again.
         let e = gaussian(5, 30);
         let noisy: Vec<Point> = sine
@@ -447,6 +450,12 @@ mod tests {
             })
             .collect();
         assert!(difference_correlation(&noisy, false).unwrap() < 0.0);
+        // The same at any scale (coordinates near the ends of the f64 range).
+        for f in [1e-150, 1e150] {
+            let scaled: Vec<[f64; 2]> = xy(&sine).iter().map(|p| [p[0] * f, p[1] * f]).collect();
+            let r = difference_correlation(&scaled, false).unwrap();
+            assert!((r - sine_r).abs() < 1e-9, "{r} against {sine_r} at {f}");
+        }
         // Nothing to correlate: too few points, or a line.
         assert!(difference_correlation(&[[0.0, 0.0]; 3], false).is_none());
         let straight: Vec<[f64; 2]> = (0..20).map(|i| [i as f64, 2.0 * i as f64]).collect();

@@ -377,8 +377,12 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
         resolve_tolerance(m, options, sigma, input.bbox().diagonal(), input.len())?;
     let options = &resolved;
     let unchanged = all_held(options, input.len(), input.is_closed()).or_else(|| {
-        let xy: Vec<[f64; 2]> = input.points().iter().map(|p| [p.x, p.y]).collect();
-        no_noise(source, &xy, input.is_closed())
+        (source == Some(ToleranceSource::Auto))
+            .then(|| {
+                let xy: Vec<[f64; 2]> = input.points().iter().map(|p| [p.x, p.y]).collect();
+                no_noise(&xy, input.is_closed())
+            })
+            .flatten()
     });
     let outcome = if let Some(note) = unchanged {
         Outcome {
@@ -425,19 +429,12 @@ const AUTO_TOLERANCE_FLOOR_REL: f64 = 1e-12;
 /// nothing anyway.
 pub(crate) const NO_NOISE_CORRELATION: f64 = 0.5;
 
-/// When the tolerance is automatic (`source`) and the points show no noise (their noise
-/// estimate's differences vary smoothly along the curve, [`NO_NOISE_CORRELATION`]): the note
-/// that says so. σ̂ then measures the curve's own shape, and a band of `k·σ̂` would only move
-/// a clean curve towards the energy's optimum (the bundled `sine-truth.csv`: its curvature
-/// error against the truth went from 0.0059 to 0.0093, its end inflections lost).
-fn no_noise<const D: usize>(
-    source: Option<ToleranceSource>,
-    pts: &[[f64; D]],
-    closed: bool,
-) -> Option<String> {
-    if source != Some(ToleranceSource::Auto) {
-        return None;
-    }
+/// For an automatic tolerance: when the points show no noise (their noise estimate's
+/// differences vary smoothly along the curve, [`NO_NOISE_CORRELATION`]), the note that says
+/// so. σ̂ then measures the curve's own shape, and a band of `k·σ̂` would only move a clean
+/// curve towards the energy's optimum (the bundled `sine-truth.csv`: its curvature error
+/// against the truth went from 0.0059 to 0.0093, its end inflections lost).
+fn no_noise<const D: usize>(pts: &[[f64; D]], closed: bool) -> Option<String> {
     let r = difference_correlation(pts, closed)?;
     (r > NO_NOISE_CORRELATION).then(|| {
         format!(
