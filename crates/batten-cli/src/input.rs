@@ -257,8 +257,9 @@ mod tests {
 /// The bounds every fairing command takes: the tolerance and what to keep at the ends.
 #[derive(Debug, Args)]
 pub struct BoundArgs {
-    /// Largest distance any point may move, in data units, or `auto`: three times the noise
-    /// estimate σ̂ of the input (`band`'s default)
+    /// Largest distance any point may move, in data units, or `auto`: k times the noise
+    /// estimate σ̂ of the input (k = 3; `band`'s default, with k = max(3, √(2 ln n))); points
+    /// in which `auto` finds no noise are left as they are
     #[arg(long, value_name = "D|auto", allow_hyphen_values = true, value_parser = parse_tolerance)]
     pub tolerance: Option<Tolerance>,
     /// Keep the ends of an open curve: the end points (bare `--fix-ends`, or `=position`),
