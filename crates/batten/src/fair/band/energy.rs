@@ -193,16 +193,6 @@ fn speed_windows<const D: usize>(
         .collect()
 }
 
-/// The spline form's speed term is the point form's times this factor. Against the jerk, the
-/// speed term of a wave `L` spacings long weighs about `L²` times more, and dense curves spread
-/// the same features over many more spacings: at the point form's weight the dense
-/// benchmark's test split (180 curves of 3000 and 10 000 points) went from 54 spurious
-/// inflections to 317. Chosen on its tuning split (`speed` 0.0005; the factor 0 / 0.001 /
-/// 0.003 / 0.01 / 0.03: 38 / 39 / 44 / 51 / 81 spurious, median curvature error 0.132 / 0.102
-/// / 0.092 / 0.089 / 0.094); the factor `1/len²` (the term with the parameter in knot spans
-/// rather than spacings) gave 0.121 with 38.
-pub(super) const SPLINE_SPEED_FACTOR: f64 = 0.003;
-
 /// The speed term of the spline form: `speed·½ ∫ (τᵀC'')² dt` over every knot span (the
 /// point form's `w_j·speed·(τ_jᵀΔ²_j)²` summed over the points, `Δ² ≈ C''/2` and two spacings
 /// a window), `τ` the unit chord of the span's control polygon. `C''` is linear on a span, so
@@ -309,11 +299,7 @@ impl<const D: usize> Energy<D> {
         if let Metric::MinVariation { speed, .. } = metric
             && speed > 0.0
         {
-            windows.extend(spline_speed_windows(
-                ctrl,
-                spans,
-                unit * speed * SPLINE_SPEED_FACTOR,
-            ));
+            windows.extend(spline_speed_windows(ctrl, spans, unit * speed));
         }
         Energy { n, closed, windows }
     }

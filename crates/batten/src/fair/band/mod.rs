@@ -290,6 +290,7 @@ fn fair_points<const D: usize>(
     params: &BandParams,
 ) -> Result<Faired<D>> {
     let n = pts.len();
+    let params = &params.at_points(n);
     // The input in units of the tolerance, about its centroid (the energy ignores
     // translation; centring keeps the numbers small).
     let centre = centroid(pts);

@@ -14,10 +14,11 @@ use super::energy::Metric;
 pub(super) const DEFAULT_PASSES: usize = 3;
 /// Default significance of a biased window in the debiasing stage.
 pub(super) const DEFAULT_LOCAL: f64 = 2.0;
-/// Default weight of the speed term of the minimum-variation energy: the value with the
-/// lowest curvature error per spurious inflection on the quality benchmark's tuning split
-/// (0.0003 / 0.0005 / 0.001: median 0.187 / 0.185 / 0.185 with 172 / 171 / 188 spurious
-/// inflections; 0: 0.193 with 155). See `docs/algorithms/band.md`, the speed term.
+/// Default weight of the speed term of the minimum-variation energy at [`SPEED_POINTS`]
+/// points: the value with the lowest curvature error per spurious inflection on the quality
+/// benchmark's tuning split (as a fixed weight, 0.0003 / 0.0005 / 0.001: median 0.187 /
+/// 0.185 / 0.185 with 172 / 171 / 188 spurious inflections; 0: 0.193 with 155). See
+/// `docs/algorithms/band.md`, the speed term.
 pub(super) const DEFAULT_SPEED: f64 = 0.0005;
 /// Default weight of the full jerk inside the minimum-variation energy.
 pub(super) const DEFAULT_EPS: f64 = 0.02;
@@ -57,6 +58,12 @@ pub(super) const EPS: Param<Number<f64>> = Param {
     doc: "weight of the full jerk inside the min-variation energy, for regularity; [0, 10]",
 };
 
+/// The number of points at which the speed term has the weight `speed`: a curve of `n` points
+/// takes `speed·(SPEED_POINTS/n)²`. Against the jerk, the speed term of a wave `L` spacings
+/// long weighs about `L²` more, and the same feature spans `n/SPEED_POINTS` times as many
+/// spacings at `n` points.
+pub(super) const SPEED_POINTS: f64 = 300.0;
+
 /// The weight of the speed term ([`DEFAULT_SPEED`]).
 pub(super) const SPEED: Param<Number<f64>> = Param {
     name: "speed",
@@ -65,7 +72,7 @@ pub(super) const SPEED: Param<Number<f64>> = Param {
         min: 0.0,
         max: 1e6,
     },
-    doc: "weight of the speed term inside the min-variation energy (the tangential second difference: keeps points from crowding where the curvature peaks; the spline form of dense curves takes 0.003 of it); [0, 1e6]",
+    doc: "weight of the speed term inside the min-variation energy (the tangential second difference: keeps points from crowding where the curvature peaks; at n points the weight is speed·(300/n)²); [0, 1e6]",
 };
 
 /// The debiasing stage's residual target ([`DEFAULT_FIT`]).
@@ -158,6 +165,16 @@ impl BandParams {
     }
 
     /// The parameters as used, for the report.
+    /// The parameters for a curve of `n` points: the speed term's weight is `speed·(300/n)²`
+    /// ([`SPEED_POINTS`]).
+    pub(super) fn at_points(&self, n: usize) -> BandParams {
+        let mut p = *self;
+        if let Metric::MinVariation { speed, .. } = &mut p.metric {
+            *speed *= (SPEED_POINTS / n.max(1) as f64).powi(2);
+        }
+        p
+    }
+
     pub(super) fn report(&self) -> Map<String, Value> {
         let mut parameters = Map::new();
         let p = &mut parameters;
