@@ -164,7 +164,6 @@ impl BandParams {
         })
     }
 
-    /// The parameters as used, for the report.
     /// The parameters for a curve of `n` points: the speed term's weight is `speed·(300/n)²`
     /// ([`SPEED_POINTS`]).
     pub(super) fn at_points(&self, n: usize) -> BandParams {
@@ -175,6 +174,7 @@ impl BandParams {
         p
     }
 
+    /// The parameters as used, for the report (`speed` as given, before [`Self::at_points`]).
     pub(super) fn report(&self) -> Map<String, Value> {
         let mut parameters = Map::new();
         let p = &mut parameters;
