@@ -510,15 +510,11 @@ proptest! {
 /// Dense points with held tangents (10 000, noise about 16 spacings) take the point form,
 /// which rounding stops short of its
 /// stopping rule (docs/algorithms/band.md, Limits). The report says so — status `stalled`,
-/// not the iteration limit, with the gap in a note — and the tolerance holds. Without the
-/// speed term: with it (the default) this run converges, its tangential direction no longer
-/// left to rounding alone.
+/// not the iteration limit, with the gap in a note — and the tolerance holds.
 #[test]
 fn a_run_that_rounding_stops_is_reported_as_stalled_within_the_tolerance() {
     let input = noisy(10_000, 0.01, 3, false);
-    let options = FairOptions::default()
-        .with_end_fix(EndFix::Tangent)
-        .with_param("speed", 0);
+    let options = FairOptions::default().with_end_fix(EndFix::Tangent);
     let out = fair::fair("band", &input, &options).expect("band runs");
     let r = &out.report;
     assert_eq!(r.status, FairStatus::Stalled, "{:?}", r.notes);
