@@ -312,6 +312,40 @@ fn exact_samples_have_no_noise_for_the_automatic_tolerance() {
     assert_eq!(out.report.status, FairStatus::Converged);
 }
 
+/// The other side of the contract: exact samples of a curve that is not fair (a parabola with
+/// a small bump, two inflections it should not have) are left alone by the automatic
+/// tolerance, which finds no noise, and faired within a tolerance given: the bump's
+/// inflections go, the variation energy falls, no point moves farther than the tolerance.
+/// A rule that left every clean input alone would leave this bump in place.
+#[test]
+fn a_clean_curve_with_a_bump_is_faired_within_a_given_tolerance() {
+    let pts: Vec<Point> = (0..200)
+        .map(|i| {
+            let x = -1.0 + 2.0 * i as f64 / 199.0;
+            let bump = 0.004 * (-((x - 0.3) / 0.08f64).powi(2)).exp();
+            Point::new(x, 0.3 * x * x + bump)
+        })
+        .collect();
+    let input = PointSeq::open(pts).unwrap();
+    let auto = fair::fair("band", &input, &FairOptions::default()).unwrap();
+    assert_eq!(auto.report.status, FairStatus::NoChange);
+    assert_eq!(auto.points.as_slice(), input.points());
+    assert_eq!(auto.report.before.inflections, 2);
+    for tol in [0.002, 0.005] {
+        let out = fair::fair("band", &input, &FairOptions::default().with_tolerance(tol)).unwrap();
+        let r = &out.report;
+        assert_eq!(r.status, FairStatus::Converged, "{tol}");
+        assert_eq!(r.after.inflections, 0, "{tol}");
+        assert!(
+            r.after.variation_energy < 0.01 * r.before.variation_energy,
+            "{tol}: {} → {}",
+            r.before.variation_energy,
+            r.after.variation_energy
+        );
+        assert!(max_move(input.points(), &out.points) <= tol);
+    }
+}
+
 #[test]
 fn takes_k_noise_estimates_when_no_tolerance_is_given() {
     let input = noisy(300, 0.03, 11, false);
