@@ -376,13 +376,12 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
     let (resolved, source) =
         resolve_tolerance(m, options, sigma, input.bbox().diagonal(), input.len())?;
     let options = &resolved;
-    let unchanged = all_held(options, input.len(), input.is_closed()).or_else(|| {
-        (source == Some(ToleranceSource::Auto))
-            .then(|| {
-                let xy: Vec<[f64; 2]> = input.points().iter().map(|p| [p.x, p.y]).collect();
-                no_noise(&xy, input.is_closed())
-            })
-            .flatten()
+    let unchanged = left_as_is(options, source, input.len(), input.is_closed(), || {
+        input
+            .points()
+            .iter()
+            .map(|p| [p.x, p.y])
+            .collect::<Vec<_>>()
     });
     let outcome = if let Some(note) = unchanged {
         Outcome {
@@ -424,7 +423,7 @@ const AUTO_TOLERANCE_FLOOR_REL: f64 = 1e-12;
 /// noise gives −0.83 (fifth differences); on the quality benchmark's 360 noisy test curves
 /// (30 to 1000 points, noise 0.1 to 1 % of the diagonal) the largest value was −0.04 (1000
 /// points at 0.1 %: there the curve's own differences weigh most), while exact samples of the
-/// bundled sine, clothoid and strophoid give 0.96 to 1.0. Exact samples whose differences are
+/// bundled sine, clothoid and strophoid give 0.90 to 1.0. Exact samples whose differences are
 /// rounding (an arc, a cubic) give about −0.8, and their σ̂, at the level of rounding, moves
 /// nothing anyway.
 pub(crate) const NO_NOISE_CORRELATION: f64 = 0.5;
@@ -443,6 +442,23 @@ fn no_noise<const D: usize>(pts: &[[f64; D]], closed: bool) -> Option<String> {
              are the curve's own shape and nothing was moved; give --tolerance to fair the \
              curve within a distance of your choice"
         )
+    })
+}
+
+/// Why the input comes back as it is without running the method, if it does: every point
+/// held ([`all_held`]), or an automatic tolerance that finds no noise ([`no_noise`]; `pts`
+/// gives the points, asked for only then).
+fn left_as_is<P: AsRef<[[f64; D]]>, const D: usize>(
+    options: &FairOptions,
+    source: Option<ToleranceSource>,
+    n: usize,
+    closed: bool,
+    pts: impl FnOnce() -> P,
+) -> Option<String> {
+    all_held(options, n, closed).or_else(|| {
+        (source == Some(ToleranceSource::Auto))
+            .then(|| no_noise(pts().as_ref(), closed))
+            .flatten()
     })
 }
 

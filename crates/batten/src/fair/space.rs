@@ -138,11 +138,7 @@ pub fn fair_space(name: &str, input: &SpaceSeq, options: &FairOptions) -> Result
     let (resolved, source) =
         super::resolve_tolerance(m, options, sigma, input.scale(), input.len())?;
     let options = &resolved;
-    let unchanged = super::all_held(options, input.len(), closed).or_else(|| {
-        (source == Some(ToleranceSource::Auto))
-            .then(|| super::no_noise(input.points(), closed))
-            .flatten()
-    });
+    let unchanged = super::left_as_is(options, source, input.len(), closed, || input.points());
     let outcome = if let Some(note) = unchanged {
         SpaceOutcome {
             points: input.points().to_vec(),
