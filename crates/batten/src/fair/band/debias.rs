@@ -258,8 +258,15 @@ impl<'a, const D: usize> Penalized<'a, D> {
                 }
             }
         }
+        self.finish_minimiser(m, y)
+    }
+
+    /// Solve for the minimiser from the matrix `m` (`2A` plus the data term) and the data
+    /// term's part `y` of the right-hand side: the held unknowns at their values, the
+    /// others pulled by the anchor and the held ones' coupling.
+    fn finish_minimiser(&self, m: Base, mut y: Vec<f64>) -> Result<Vec<f64>> {
         for (k, yk) in y.iter_mut().enumerate() {
-            *yk = if held[k / D] {
+            *yk = if self.held[k / D] {
                 self.fixed[k]
             } else {
                 *yk - 2.0 * self.anchor[k] - 2.0 * self.coupling[k]
@@ -267,6 +274,44 @@ impl<'a, const D: usize> Penalized<'a, D> {
         }
         m.factorize_and_solve(&mut y)?;
         Ok(y)
+    }
+
+    /// [`Penalized::minimiser`] with the weight `mu` at every point but those of `raised`,
+    /// whose weights `weights` gives: in the spline form the uniform part comes from the
+    /// sums assembled once and only the raised points are visited, so a round of
+    /// [`super::spline::feasible_fit`], which raises a few points of 10⁶, costs a
+    /// factorisation rather than a sweep over every point.
+    pub(super) fn minimiser_raised(
+        &self,
+        mu: f64,
+        weights: &[f64],
+        raised: &[usize],
+    ) -> Result<Vec<f64>> {
+        let Design::Spline(map) = self.design else {
+            return self.minimiser(|i| weights[i], false);
+        };
+        let held = self.held;
+        let mut m = self.base.clone();
+        let mut y: Vec<f64> = self.pull.iter().map(|p| mu * p).collect();
+        for (r, c, v) in &self.gram {
+            m.add(*r, *c, mu * v);
+        }
+        for &i in raised.iter().filter(|&&i| !self.pinned[i]) {
+            let extra = 2.0 * (weights[i] - mu);
+            let shifted: [f64; D] = std::array::from_fn(|a| self.shifted[i * D + a]);
+            map.add_point::<D>(
+                i,
+                extra,
+                &shifted,
+                |r, c, v| {
+                    if !held[r / D] && !held[c / D] {
+                        m.add(r, c, v);
+                    }
+                },
+                &mut y,
+            );
+        }
+        self.finish_minimiser(m, y)
     }
 
     /// `E(s + y)` from `A s` and `E(s)`.

@@ -6,6 +6,11 @@
 //! four consecutive control points, so every matrix the solver builds keeps the band of the
 //! energy (half-bandwidth `4D − 1` in the interleaved numbering).
 
+use rayon::prelude::*;
+
+/// Points a task of [`Design::eval`] evaluates.
+const EVAL_CHUNK: usize = 1 << 14;
+
 /// The map from unknowns to points.
 #[derive(Clone, Debug)]
 pub(super) enum Design {
@@ -24,6 +29,50 @@ pub(super) struct SplineMap {
     pub first: Vec<usize>,
     /// The four basis values of each point.
     pub basis: Vec<[f64; 4]>,
+}
+
+impl SplineMap {
+    /// Call `add(row, col, value)` for the entries with `row ≥ col` of the 4×4 block `acc`
+    /// (every coordinate) of the span whose first control point is `f`.
+    fn add_span_lower<const D: usize>(
+        &self,
+        f: usize,
+        acc: &[[f64; 4]; 4],
+        add: &mut impl FnMut(usize, usize, f64),
+    ) {
+        for (k, row) in acc.iter().enumerate() {
+            let r0 = ((f + k) % self.vars) * D;
+            for (l, v) in row.iter().enumerate() {
+                let c0 = ((f + l) % self.vars) * D;
+                if r0 >= c0 {
+                    for a in 0..D {
+                        add(r0 + a, c0 + a, *v);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Call `add(row, col, value)` for the entries with `row ≥ col` of `w B_iᵀ B_i` (point
+    /// `i` alone, `w` on every coordinate), and add `w B_iᵀ v` to `out`.
+    pub(super) fn add_point<const D: usize>(
+        &self,
+        i: usize,
+        w: f64,
+        v: &[f64; D],
+        mut add: impl FnMut(usize, usize, f64),
+        out: &mut [f64],
+    ) {
+        let (f, b) = (self.first[i], self.basis[i]);
+        let acc: [[f64; 4]; 4] = std::array::from_fn(|k| std::array::from_fn(|l| w * b[k] * b[l]));
+        self.add_span_lower::<D>(f, &acc, &mut add);
+        for (k, bk) in b.iter().enumerate() {
+            let j = (f + k) % self.vars;
+            for a in 0..D {
+                out[j * D + a] += w * bk * v[a];
+            }
+        }
+    }
 }
 
 impl Design {
@@ -48,25 +97,35 @@ impl Design {
         match self {
             Design::Points { .. } => out.copy_from_slice(x),
             Design::Spline(s) => {
-                for (i, (&f, b)) in s.first.iter().zip(&s.basis).enumerate() {
-                    let mut q = [0.0; D];
-                    if f + 4 <= s.vars {
-                        let x = &x[f * D..(f + 4) * D];
-                        for (k, bk) in b.iter().enumerate() {
-                            for a in 0..D {
-                                q[a] += bk * x[k * D + a];
+                // Every point on its own: in chunks on the pool's threads (the same sums
+                // whatever the split).
+                out.par_chunks_mut(EVAL_CHUNK * D)
+                    .enumerate()
+                    .for_each(|(c, out)| {
+                        let from = c * EVAL_CHUNK;
+                        for (o, (&f, b)) in out
+                            .chunks_exact_mut(D)
+                            .zip(s.first[from..].iter().zip(&s.basis[from..]))
+                        {
+                            let mut q = [0.0; D];
+                            if f + 4 <= s.vars {
+                                let x = &x[f * D..(f + 4) * D];
+                                for (k, bk) in b.iter().enumerate() {
+                                    for a in 0..D {
+                                        q[a] += bk * x[k * D + a];
+                                    }
+                                }
+                            } else {
+                                for (k, bk) in b.iter().enumerate() {
+                                    let j = (f + k) % s.vars;
+                                    for a in 0..D {
+                                        q[a] += bk * x[j * D + a];
+                                    }
+                                }
                             }
+                            o.copy_from_slice(&q);
                         }
-                    } else {
-                        for (k, bk) in b.iter().enumerate() {
-                            let j = (f + k) % s.vars;
-                            for a in 0..D {
-                                q[a] += bk * x[j * D + a];
-                            }
-                        }
-                    }
-                    out[i * D..(i + 1) * D].copy_from_slice(&q);
-                }
+                    });
             }
         }
     }
@@ -195,18 +254,8 @@ impl Design {
                 let mut acc = [[0.0; 4]; 4];
                 let mut current = None;
                 let mut flush = |f: usize, acc: &mut [[f64; 4]; 4]| {
-                    for (k, row) in acc.iter_mut().enumerate() {
-                        let r0 = ((f + k) % s.vars) * D;
-                        for (l, v) in row.iter_mut().enumerate() {
-                            let c0 = ((f + l) % s.vars) * D;
-                            if r0 >= c0 {
-                                for a in 0..D {
-                                    add(r0 + a, c0 + a, *v);
-                                }
-                            }
-                            *v = 0.0;
-                        }
-                    }
+                    s.add_span_lower::<D>(f, acc, &mut add);
+                    *acc = [[0.0; 4]; 4];
                 };
                 for (i, (&f, b)) in s.first.iter().zip(&s.basis).enumerate() {
                     if skip[i] {

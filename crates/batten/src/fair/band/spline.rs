@@ -203,10 +203,12 @@ pub(super) fn feasible_fit<const D: usize>(
     let fit = Penalized::new(energy, unit, design, held, pinned, fixed, &anchor, centres);
     let mu = unit * (FIT_SMOOTHING_SPANS * layout.span_length).powi(-6);
     let mut weights = vec![mu; design.points()];
+    // The points whose weight was raised (few: those the smooth fit left outside).
+    let mut raised: Vec<usize> = Vec::new();
     let mut closest = Closest::default();
-    for round in 0..FIT_ROUNDS {
+    for _ in 0..FIT_ROUNDS {
         // A fit whose matrix rounding makes singular is no start.
-        let Ok(x) = fit.minimiser(|i| weights[i], round == 0) else {
+        let Ok(x) = fit.minimiser_raised(mu, &weights, &raised) else {
             break;
         };
         let r = fit.residual(&x);
@@ -218,6 +220,9 @@ pub(super) fn feasible_fit<const D: usize>(
                 .sqrt();
             farthest = farthest.max(len);
             if len > START_RADIUS {
+                if *w == mu {
+                    raised.push(i);
+                }
                 *w = (*w * (len / START_RADIUS).powi(4).max(2.0)).min(MAX_WEIGHT_GROWTH * mu);
             }
         }
