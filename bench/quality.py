@@ -155,6 +155,8 @@ AUTO_TOLERANCE_FLOOR_REL = 1e-12  # batten's floor of `auto`, fraction of the di
 OCCT_WEIGHTS = (0.4, 0.2, 0.4)
 OCCT_DEGMAX = 8
 MAD_TO_SIGMA = 1.4826  # the MAD-to-σ factor for Gaussian noise
+CLIP, CLIP_ROUNDS = 3.0, 3  # σ̂'s clipped root mean square, as batten takes it
+CLIPPED_SQUARE_1D = 0.9733369246625415  # E[v² | |v| ≤ 3σ]/σ² for Gaussian v
 NORMAL_CHORD_NOISE_SPANS = 20.0  # batten's: the normal's chord spans about this many rough noise scales
 OCCT_CHECK_REL = 1e-9  # check_occt: the peer's points on the API's curve to this fraction of the diagonal
 OCCT_TIE_GAP = 1e-9  # parameters closer than this fraction of the range count as one (spread_ties)
@@ -471,11 +473,13 @@ def match(result_pos, true_pos, window):
 
 
 def noise_sigma(p, closed=False):
-    """batten's noise estimate σ̂ (`analysis/noise.rs`): 1.4826·median|n·Δᵏp|/√C(2k, k), with
+    """batten's noise estimate σ̂ (`analysis/noise.rs`) from the parts v_i = |n·Δᵏp_i|/√C(2k, k),
     k = 5 (k = 3 below 8 points), n the normal of the chord p[i+k+m] − p[i−m] (indices clamped
     on an open curve, wrapped on a closed one); m = 0 unless the noise is comparable to the
-    spacing: m = ⌈20·rough/spacing⌉ ≤ n/8, rough the same MAD over the whole |Δᵏp|, spacing the
-    median distance of neighbours."""
+    spacing: m = ⌈20·rough/spacing⌉ ≤ n/8, rough the MAD over the whole |Δᵏp|, spacing the
+    median distance of neighbours. σ̂ starts as 1.4826·median v, then three times
+    σ̂ ← √(mean of v² over v ≤ 3σ̂ / 0.97334), the root mean square clipped at 3σ̂ and
+    corrected for the clipping."""
     n = len(p)
     if n < 4:
         return 0.0
@@ -497,7 +501,16 @@ def noise_sigma(p, closed=False):
     ln = np.hypot(ch[:, 0], ch[:, 1])
     ok = ln > 0
     v = np.abs(dk[ok, 0] * ch[ok, 1] - dk[ok, 1] * ch[ok, 0]) / ln[ok]
-    return float(MAD_TO_SIGMA * _upper_median(v) / gain)
+    s = MAD_TO_SIGMA * _upper_median(v)
+    if not (s > 0 and math.isfinite(s)):
+        return float(s / gain)
+    for _ in range(CLIP_ROUNDS):
+        u = v / s
+        kept = u[u <= CLIP]
+        if len(kept) == 0:
+            break
+        s *= math.sqrt(np.sum(kept * kept) / len(kept) / CLIPPED_SQUARE_1D)
+    return float(s / gain)
 
 
 def _upper_median(v):
