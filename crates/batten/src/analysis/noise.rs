@@ -22,8 +22,8 @@
 //! ten curve families at 30 points give σ̂ a median of 3.6e-4 of the diagonal with third
 //! differences, 8.4e-6 with fifth ones (at 100 points 8.9e-6 and 2.0e-8), and `band`'s
 //! automatic tolerance on them moved the curve by up to that much. On noisy samples (0.1 to
-//! 1 % of the diagonal, 30 to 1000 points) the two orders are equally accurate (median
-//! σ̂/σ 0.98 to 1.17 for both); at 30 points and 0.1 % noise the fifth order's worst case is
+//! 1 % of the diagonal, 30 to 1000 points) the two orders are equally accurate (with the
+//! median alone, median σ̂/σ 0.98 to 1.17 for both); at 30 points and 0.1 % noise the fifth order's worst case is
 //! 1.65 σ against 3.03.
 //!
 //! A MAD pooled over both coordinates underestimates noise that lies in one coordinate only
