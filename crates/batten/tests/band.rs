@@ -346,6 +346,66 @@ fn a_clean_curve_with_a_bump_is_faired_within_a_given_tolerance() {
     }
 }
 
+/// A sine of 1000 points with Gaussian noise of σ = 0.01, and `outliers` of its points
+/// moved a further 10σ in y (every 20th point from the 7th, up and down by turns).
+fn sine_with_outliers(outliers: usize) -> PointSeq {
+    let mut pts = jitter(&common::sine(1000, 12.0), Noise::Gaussian(0.01), 17);
+    for (j, i) in (7..1000).step_by(20).take(outliers).enumerate() {
+        pts[i].y += if j % 2 == 0 { 0.1 } else { -0.1 };
+    }
+    PointSeq::open(pts).expect("valid points")
+}
+
+/// The automatic tolerance is a noise model (Gaussian, the same σ in every direction); where
+/// the debiased fit presses the band's edge at more points than the model allows, the
+/// tolerance is widened (by 1.2, at most 10 times) and the note says so. With 40 outliers at
+/// 10σ, a band of `k·σ̂` forces the curve through them; widened, it need not.
+#[test]
+fn outliers_widen_the_automatic_tolerance() {
+    let input = sine_with_outliers(40);
+    let auto = fair::fair("band", &input, &FairOptions::default()).unwrap();
+    let r = &auto.report;
+    let sigma = r.noise_sigma.unwrap();
+    let first = fair::band_tolerance_factor(1000) * sigma;
+    let d = r.tolerance.unwrap();
+    assert_eq!(r.tolerance_source, Some(ToleranceSource::Auto));
+    assert!(d > 1.19 * first, "{d} against k·σ̂ = {first}");
+    assert!(r.max_displacement <= d);
+    assert!(
+        r.notes
+            .iter()
+            .any(|n| n.contains("--tolerance auto widened")),
+        "{:?}",
+        r.notes
+    );
+    // The same data in a band of k·σ̂, given: the curve bends to the outliers.
+    let narrow = fair::fair(
+        "band",
+        &input,
+        &FairOptions::default().with_tolerance(first),
+    )
+    .unwrap();
+    assert!(
+        r.after.inflections < narrow.report.after.inflections,
+        "{} widened against {} in k·σ̂",
+        r.after.inflections,
+        narrow.report.after.inflections
+    );
+    // Gaussian noise alone: the model holds, nothing is widened.
+    let clean = fair::fair("band", &sine_with_outliers(0), &FairOptions::default()).unwrap();
+    assert!(clean.report.notes.iter().all(|n| !n.contains("widened")));
+    let k = fair::band_tolerance_factor(1000) * clean.report.noise_sigma.unwrap();
+    assert!((clean.report.tolerance.unwrap() - k).abs() <= 1e-12 * k);
+    // `--set k=` chooses the band's width: not widened either.
+    let chosen = fair::fair(
+        "band",
+        &input,
+        &FairOptions::default().with_param("k", 3.72),
+    )
+    .unwrap();
+    assert!((chosen.report.tolerance.unwrap() - 3.72 * sigma).abs() <= 1e-12 * d);
+}
+
 #[test]
 fn takes_k_noise_estimates_when_no_tolerance_is_given() {
     let input = noisy(300, 0.03, 11, false);

@@ -355,6 +355,7 @@ impl LocalReport {
         notes.extend(self.notes);
         Outcome {
             solver: None,
+            pressed: None,
             points,
             status: self.status,
             iterations: self.iterations,

@@ -127,6 +127,12 @@ pub struct Outcome {
     pub tangents: Option<Vec<Vec2>>,
     /// The solver's figures, for methods that solve an optimisation problem.
     pub solver: Option<SolverInfo>,
+    /// For a result fitted back towards the data inside the tolerance band (`band` after its
+    /// debiasing stage, its `k` automatic): how many points press the band's edge. An
+    /// automatic tolerance checks its noise model by it (see `run_widening`); `None` where
+    /// the band is not what decides the fit's distance from the data, or its width was
+    /// chosen (`--set k=`).
+    pub pressed: Option<usize>,
     /// What the method held at the ends of an open curve when that is more than
     /// `--fix-ends` asked (`han` and `cali` always keep the end points); the report's
     /// `fix_ends` and `fixed_ends` say what was held.
@@ -375,8 +381,8 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
     let sigma = noise_sigma(input.points(), input.is_closed());
     let (resolved, source) =
         resolve_tolerance(m, options, sigma, input.bbox().diagonal(), input.len())?;
-    let options = &resolved;
-    let unchanged = left_as_is(options, source, input.len(), input.is_closed(), || {
+    let mut resolved = resolved;
+    let unchanged = left_as_is(&resolved, source, input.len(), input.is_closed(), || {
         input
             .points()
             .iter()
@@ -392,16 +398,23 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
         }
     } else {
         let s = guard::method_scale(input);
-        let run_options = guard::per_move_options(options, &before);
-        if s == 1.0 {
-            m.run(input, &run_options)?
-        } else {
-            let (unit, unit_options) = guard::to_unit(m, input, &run_options, s)?;
-            let mut outcome = m.run(&unit, &unit_options)?;
-            guard::from_unit(m, &mut outcome, s)?;
-            outcome
-        }
+        let run = |options: &FairOptions| -> Result<Outcome> {
+            let run_options = guard::per_move_options(options, &before);
+            if s == 1.0 {
+                m.run(input, &run_options)
+            } else {
+                let (unit, unit_options) = guard::to_unit(m, input, &run_options, s)?;
+                let mut outcome = m.run(&unit, &unit_options)?;
+                guard::from_unit(m, &mut outcome, s)?;
+                Ok(outcome)
+            }
+        };
+        let edge = |o: &Outcome| o.pressed;
+        let (mut outcome, note) = run_widening(&mut resolved, source, input.len(), edge, run)?;
+        outcome.notes.extend(note);
+        outcome
     };
+    let options = &resolved;
     finish(
         m,
         (input, None),
@@ -443,6 +456,59 @@ fn no_noise<const D: usize>(pts: &[[f64; D]], closed: bool) -> Option<String> {
              curve within a distance of your choice"
         )
     })
+}
+
+/// Points that may press the band's edge before an automatic tolerance is taken as too
+/// narrow: at least this many, and at least [`EDGE_ALLOWANCE_FRACTION`] of the points.
+const EDGE_ALLOWANCE_MIN: usize = 2;
+/// See [`EDGE_ALLOWANCE_MIN`].
+const EDGE_ALLOWANCE_FRACTION: f64 = 0.003;
+/// The factor by which each round widens an automatic tolerance.
+const WIDEN_FACTOR: f64 = 1.2;
+/// The most rounds of widening (`1.2¹⁰ ≈ 6.2`).
+const MAX_WIDENINGS: i32 = 10;
+
+/// Run the method (`run`) with `options`, and for an automatic tolerance check the result
+/// against the noise model the tolerance came from. `k·σ̂` with `k = √(2 ln n)` leaves
+/// about one true point outside the band for Gaussian noise of the same σ in every
+/// direction, so a fit near the truth touches the band's edge at a point or two (`edge`
+/// says how many, for methods that fit back towards the data inside a band:
+/// [`Outcome::pressed`]). Where it presses the edge at more than `max(2, 0.3 % of the
+/// points)`, the model is wrong for these data (noise with heavier tails than Gaussian's,
+/// outliers, or noise in one direction, whose part along the curve the estimate along the
+/// normal does not see), and the band forces the curve towards the noise: the tolerance is
+/// widened by 1.2 and the method run again, at most 10 times. `options` keeps the tolerance
+/// used; the note says what was widened and why.
+fn run_widening<O>(
+    options: &mut FairOptions,
+    source: Option<ToleranceSource>,
+    n: usize,
+    edge: impl Fn(&O) -> Option<usize>,
+    mut run: impl FnMut(&FairOptions) -> Result<O>,
+) -> Result<(O, Option<String>)> {
+    let mut outcome = run(options)?;
+    let (Some(ToleranceSource::Auto), Some(first)) = (source, options.tolerance) else {
+        return Ok((outcome, None));
+    };
+    let allowance = EDGE_ALLOWANCE_MIN.max((EDGE_ALLOWANCE_FRACTION * n as f64) as usize);
+    let Some(pressed) = edge(&outcome).filter(|&e| e > allowance) else {
+        return Ok((outcome, None));
+    };
+    let mut rounds = 0;
+    while rounds < MAX_WIDENINGS && edge(&outcome).is_some_and(|e| e > allowance) {
+        rounds += 1;
+        options.tolerance = Some(first * WIDEN_FACTOR.powi(rounds));
+        outcome = run(options)?;
+    }
+    let last = options.tolerance.unwrap_or(first);
+    let now = edge(&outcome).unwrap_or(0);
+    let note = format!(
+        "--tolerance auto widened k·σ̂ = {first:.6e} to {last:.6e} ({WIDEN_FACTOR}^{rounds}): \
+         {pressed} points pressed the band's edge where Gaussian noise of the estimated size \
+         allows {allowance} (noise with heavier tails, outliers, or noise in one direction); \
+         {now} press it now (see docs/algorithms/band.md, The tolerance)"
+    );
+    Ok((outcome, Some(note)))
 }
 
 /// Why the input comes back as it is without running the method, if it does: every point

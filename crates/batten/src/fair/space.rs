@@ -35,6 +35,8 @@ pub struct SpaceOutcome {
     pub notes: Vec<String>,
     /// The solver's figures (`band`).
     pub solver: Option<SolverInfo>,
+    /// As [`Outcome::pressed`].
+    pub pressed: Option<usize>,
 }
 
 /// The report of fairing a space curve: the planar report's keys that make sense in space,
@@ -108,6 +110,7 @@ impl SpaceOutcome {
             parameters: o.parameters,
             notes: o.notes,
             solver: o.solver,
+            pressed: o.pressed,
         }
     }
 }
@@ -137,8 +140,8 @@ pub fn fair_space(name: &str, input: &SpaceSeq, options: &FairOptions) -> Result
     let sigma = noise_sigma_space(input.points(), closed);
     let (resolved, source) =
         super::resolve_tolerance(m, options, sigma, input.scale(), input.len())?;
-    let options = &resolved;
-    let unchanged = super::left_as_is(options, source, input.len(), closed, || input.points());
+    let mut resolved = resolved;
+    let unchanged = super::left_as_is(&resolved, source, input.len(), closed, || input.points());
     let outcome = if let Some(note) = unchanged {
         SpaceOutcome {
             points: input.points().to_vec(),
@@ -148,16 +151,24 @@ pub fn fair_space(name: &str, input: &SpaceSeq, options: &FairOptions) -> Result
         }
     } else {
         let s = guard::method_scale_of(unit_scale);
-        if s == 1.0 {
-            run(m, input, options)?
-        } else {
-            let unit_options = guard::unit_options(m, options, s)?;
-            let mut o = run(m, &scaled_seq(input, 1.0 / s)?, &unit_options)?;
-            o.points = scale_xyz(&o.points, s);
-            guard::trace_from_unit(m, &mut o.history, &mut o.parameters, &mut o.notes, s);
-            o
-        }
+        let run_once = |options: &FairOptions| -> Result<SpaceOutcome> {
+            if s == 1.0 {
+                run(m, input, options)
+            } else {
+                let unit_options = guard::unit_options(m, options, s)?;
+                let mut o = run(m, &scaled_seq(input, 1.0 / s)?, &unit_options)?;
+                o.points = scale_xyz(&o.points, s);
+                guard::trace_from_unit(m, &mut o.history, &mut o.parameters, &mut o.notes, s);
+                Ok(o)
+            }
+        };
+        let edge = |o: &SpaceOutcome| o.pressed;
+        let (mut outcome, note) =
+            super::run_widening(&mut resolved, source, input.len(), edge, run_once)?;
+        outcome.notes.extend(note);
+        outcome
     };
+    let options = &resolved;
     finish_space(
         m,
         input,

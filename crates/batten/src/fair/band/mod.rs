@@ -239,6 +239,11 @@ fn run_points<const D: usize>(
         iterations: faired.solver.iterations,
         history: faired.history,
         parameters,
+        // With `k` given, the band's width is the user's choice, not a noise model's.
+        pressed: faired
+            .fidelity
+            .filter(|_| params.k.is_none())
+            .map(|_| faired.solver.points_on_band_edge),
         solver: Some(faired.solver),
         notes,
         ..Outcome::default()

@@ -120,6 +120,7 @@ pub(super) fn run_cali(points: &[Point], s: &Settings) -> Result<Outcome> {
 
     Ok(Outcome {
         solver: None,
+        pressed: None,
         points: run.out,
         status,
         iterations: run.moves.len(),

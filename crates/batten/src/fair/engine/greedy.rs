@@ -229,6 +229,7 @@ impl Driven {
     ) -> Outcome {
         Outcome {
             solver: None,
+            pressed: None,
             points,
             status: self.status,
             iterations: self.moves.len(),
