@@ -215,6 +215,10 @@ impl<'a, const D: usize> Penalized<'a, D> {
     ) -> Result<Vec<f64>> {
         let held = self.held;
         let dim = self.energy.n * D;
+        if uniform && matches!(self.design, Design::Spline(_)) {
+            let (m, y) = self.uniform_spline_term(weight(0));
+            return self.finish_minimiser(m, y);
+        }
         let mut m = self.base.clone();
         let mut y = vec![0.0; dim];
         match self.design {
@@ -230,32 +234,22 @@ impl<'a, const D: usize> Penalized<'a, D> {
                 }
             }
             Design::Spline(_) => {
-                if uniform {
-                    let mu = weight(0);
-                    for (k, yk) in y.iter_mut().enumerate() {
-                        *yk = mu * self.pull[k];
-                    }
-                    for (r, c, v) in &self.gram {
-                        m.add(*r, *c, mu * v);
-                    }
-                } else {
-                    self.design.for_each_weight_lower::<D>(
-                        |i| 2.0 * weight(i),
-                        self.pinned,
-                        |r, c, v| {
-                            if !held[r / D] && !held[c / D] {
-                                m.add(r, c, v);
-                            }
-                        },
-                    );
-                    let weighted: Vec<f64> = self
-                        .shifted
-                        .iter()
-                        .enumerate()
-                        .map(|(k, c)| 2.0 * weight(k / D) * c)
-                        .collect();
-                    self.design.eval_t_add::<D>(&weighted, &mut y);
-                }
+                self.design.for_each_weight_lower::<D>(
+                    |i| 2.0 * weight(i),
+                    self.pinned,
+                    |r, c, v| {
+                        if !held[r / D] && !held[c / D] {
+                            m.add(r, c, v);
+                        }
+                    },
+                );
+                let weighted: Vec<f64> = self
+                    .shifted
+                    .iter()
+                    .enumerate()
+                    .map(|(k, c)| 2.0 * weight(k / D) * c)
+                    .collect();
+                self.design.eval_t_add::<D>(&weighted, &mut y);
             }
         }
         self.finish_minimiser(m, y)
@@ -291,11 +285,7 @@ impl<'a, const D: usize> Penalized<'a, D> {
             return self.minimiser(|i| weights[i], false);
         };
         let held = self.held;
-        let mut m = self.base.clone();
-        let mut y: Vec<f64> = self.pull.iter().map(|p| mu * p).collect();
-        for (r, c, v) in &self.gram {
-            m.add(*r, *c, mu * v);
-        }
+        let (mut m, mut y) = self.uniform_spline_term(mu);
         for &i in raised.iter().filter(|&&i| !self.pinned[i]) {
             let extra = 2.0 * (weights[i] - mu);
             let shifted: [f64; D] = std::array::from_fn(|a| self.shifted[i * D + a]);
@@ -312,6 +302,16 @@ impl<'a, const D: usize> Penalized<'a, D> {
             );
         }
         self.finish_minimiser(m, y)
+    }
+
+    /// The spline form's matrix `2A` and right-hand side with the data term of weight `mu`
+    /// at every point, from the sums assembled once (`2 BᵀB` and `2 Bᵀ(c − B x_held)`).
+    fn uniform_spline_term(&self, mu: f64) -> (Base, Vec<f64>) {
+        let mut m = self.base.clone();
+        for (r, c, v) in &self.gram {
+            m.add(*r, *c, mu * v);
+        }
+        (m, self.pull.iter().map(|p| mu * p).collect())
     }
 
     /// `E(s + y)` from `A s` and `E(s)`.

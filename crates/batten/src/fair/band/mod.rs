@@ -31,7 +31,8 @@
 //! `--tolerance D`, or by default `D = k·σ̂` (`k = max(3, √(2 ln n))`, [`auto_k`]; `--set k=`),
 //! with `σ̂` the noise estimate
 //! of [`crate::analysis::noise_sigma`] (fifth differences along the local normal: their
-//! median absolute value, then their root mean square clipped at 3σ̂). The report gives `noise_sigma`, the `tolerance` and `tolerance_source`.
+//! median absolute value, then their root mean square clipped at 3σ̂). The report gives
+//! `noise_sigma`, the `tolerance` and `tolerance_source`.
 //!
 //! # The solver
 //!
