@@ -42,10 +42,10 @@ pub use gfi::{FairnessIndicators, fairness_indicators};
 pub use metrics::{
     Displacement, FairnessMetrics, ZERO_REL, analysis_curve, count_sign_changes, displacement, sgn0,
 };
-pub(crate) use noise::is_planar;
 pub use noise::{
     MAD_TO_SIGMA, MEDIAN_LENGTH_2D_TO_SIGMA, difference_correlation, noise_sigma, noise_sigma_space,
 };
+pub(crate) use noise::{NoiseMeasure, Spread, is_planar};
 pub use roc_fairness::{
     DEFAULT_METHOD_GRADIENT_FRACTION, DegreeResult, Design as RocDesign, DesignEnds,
     Evaluation as RocEvaluation, KuraganoOptions, MAX_SAMPLES as ROC_MAX_SAMPLES,

@@ -14,7 +14,7 @@
 //! estimator: over noise draws its spread is half as large again as a mean square's, and an
 //! underestimate narrows `band`'s band and lowers its debiasing target, both of which leave
 //! spurious inflections. Clipped at 3σ̂, the mean square keeps the robustness (see
-//! [`off_tangent_sigma`] for the figures).
+//! [`NoiseMeasure::sigma`] for the figures).
 //!
 //! The order is 5 (`√C(10, 5) = √252`), 3 below `FIFTH_ORDER_POINTS` points. Each order
 //! divides the curve's own part by about `h / L` (`L` the curve's length scale) and leaves the
@@ -67,7 +67,7 @@ const NORMAL_CHORD_NOISE_SPANS: f64 = 20.0;
 /// difference vectors, an overestimate) — at most an eighth of the points.
 pub fn noise_sigma(pts: &[Point], closed: bool) -> f64 {
     let xy: Vec<[f64; 2]> = pts.iter().map(|p| [p.x, p.y]).collect();
-    off_tangent_sigma(&xy, closed, Spread::OneD)
+    NoiseMeasure::of(&xy, closed).sigma(Spread::OneD)
 }
 
 /// The median of the length of a 2-D Gaussian vector of unit standard deviation per
@@ -90,12 +90,7 @@ const PLANAR_REL: f64 = 1e-9;
 /// [`noise_sigma`]'s factor: their σ̂ is the planar one (bit for bit at `z ≡ 0`, to rounding in
 /// any other plane).
 pub fn noise_sigma_space(pts: &[[f64; 3]], closed: bool) -> f64 {
-    let spread = if is_planar(pts) {
-        Spread::OneD
-    } else {
-        Spread::TwoD
-    };
-    off_tangent_sigma(pts, closed, spread)
+    NoiseMeasure::of(pts, closed).sigma(Spread::of_space(pts))
 }
 
 /// Whether the points lie in one plane (to `PLANAR_REL` of their size; noise included, so
@@ -269,7 +264,7 @@ const CLIP_ROUNDS: usize = 3;
 
 /// How the parts off the local chord spread for Gaussian noise of `σ` per coordinate.
 #[derive(Clone, Copy, Debug)]
-enum Spread {
+pub(crate) enum Spread {
     /// One coordinate (a planar curve's normal component): `N(0, σ²)`.
     OneD,
     /// Two coordinates (a space curve's part off the chord), whose length is Rayleigh.
@@ -277,6 +272,16 @@ enum Spread {
 }
 
 impl Spread {
+    /// The spread of a space curve's parts: one coordinate for points in one plane
+    /// ([`is_planar`]), two otherwise.
+    pub(crate) fn of_space(pts: &[[f64; 3]]) -> Spread {
+        if is_planar(pts) {
+            Spread::OneD
+        } else {
+            Spread::TwoD
+        }
+    }
+
     /// The factor that turns the median of the parts' lengths into σ.
     fn median_to_sigma(self) -> f64 {
         match self {
@@ -296,58 +301,119 @@ impl Spread {
     }
 }
 
-/// σ̂ from the differences' parts off the local chord (see the module's documentation): the
-/// median's estimate, then [`CLIP_ROUNDS`] times the root mean square of the parts within
-/// [`CLIP`]·σ̂, corrected for the clipping. The median alone ignores the curve's own large
-/// differences but wastes the rest: its spread over noise draws is half as large again as a
-/// mean square's. Clipped at 3σ̂ the estimate keeps the median's robustness and most of the
-/// mean square's precision (on the quality benchmark's tuning curves the spread of
-/// `ln(σ̂/σ)` fell from 0.181 to 0.139, at 30 points from 0.31 to 0.24). 0 for fewer than
-/// four points or where every part vanishes.
-fn off_tangent_sigma<const D: usize>(pts: &[[f64; D]], closed: bool, spread: Spread) -> f64 {
-    let Some((mut parts, gain)) = off_tangent_parts(pts, closed) else {
-        return 0.0;
-    };
-    let mut sigma = median(&mut parts) * spread.median_to_sigma();
-    if !(sigma > 0.0 && sigma.is_finite()) {
-        return sigma / gain;
-    }
-    for _ in 0..CLIP_ROUNDS {
-        // In units of the last σ̂, so that no square under- or overflows.
-        let (sum, kept) = parts
-            .iter()
-            .map(|v| v / sigma)
-            .filter(|u| *u <= CLIP)
-            .fold((0.0, 0usize), |(s, k), u| (s + u * u, k + 1));
-        if kept == 0 {
-            break;
-        }
-        sigma *= (sum / kept as f64 / spread.clipped_square()).sqrt();
-    }
-    sigma / gain
+/// The differences of a curve's points that σ̂ ([`NoiseMeasure::sigma`]) and the correlation
+/// that tells noise from a clean curve ([`NoiseMeasure::correlation`]) are both taken from,
+/// made once for both: a fair with `--tolerance auto` asks for both, and at 10⁶ points the
+/// differences and their two medians are about half of either's time.
+pub(crate) struct NoiseMeasure<'p, const D: usize> {
+    pts: &'p [[f64; D]],
+    closed: bool,
+    /// `None` below four points.
+    diffs: Option<Differences<D>>,
 }
 
-/// The lengths of the differences' parts off the local chord, in any dimension, and the
-/// noise gain `√C(2k, k)` of the differences used (`None` below four points).
-fn off_tangent_parts<const D: usize>(pts: &[[f64; D]], closed: bool) -> Option<(Vec<f64>, f64)> {
-    let diffs = Differences::of(pts, closed)?;
-    let count = diffs.differences.len();
-    // The differences without a chord are skipped; the vector is reserved whole (collected
-    // from a filter, it grew by doubling: a tenth of a 200-point fair's instructions went to
-    // growing the vectors here).
-    let part = |i: usize| {
-        let chord = diffs.chord(pts, closed, i);
-        let len = length(&chord);
-        (len > 0.0).then(|| off_axis(&diffs.differences[i], &chord) / len)
-    };
-    let mut normal_parts = Vec::with_capacity(count);
-    if count >= PARALLEL_FROM {
-        use rayon::prelude::*;
-        normal_parts.par_extend((0..count).into_par_iter().filter_map(part));
-    } else {
-        normal_parts.extend((0..count).filter_map(part));
+impl<'p, const D: usize> NoiseMeasure<'p, D> {
+    /// The differences of `pts` (cyclic when `closed`).
+    pub(crate) fn of(pts: &'p [[f64; D]], closed: bool) -> NoiseMeasure<'p, D> {
+        NoiseMeasure {
+            pts,
+            closed,
+            diffs: Differences::of(pts, closed),
+        }
     }
-    Some((normal_parts, diffs.gain))
+
+    /// σ̂ from the differences' parts off the local chord (see the module's documentation):
+    /// the median's estimate, then [`CLIP_ROUNDS`] times the root mean square of the parts
+    /// within [`CLIP`]·σ̂, corrected for the clipping. The median alone ignores the curve's
+    /// own large differences but wastes the rest: its spread over noise draws is half as large
+    /// again as a mean square's. Clipped at 3σ̂ the estimate keeps the median's robustness and
+    /// most of the mean square's precision (on the quality benchmark's tuning curves the
+    /// spread of `ln(σ̂/σ)` fell from 0.181 to 0.139, at 30 points from 0.31 to 0.24). 0 for
+    /// fewer than four points or where every part vanishes.
+    pub(crate) fn sigma(&self, spread: Spread) -> f64 {
+        let Some((mut parts, gain)) = self.off_tangent_parts() else {
+            return 0.0;
+        };
+        let mut sigma = median(&mut parts) * spread.median_to_sigma();
+        if !(sigma > 0.0 && sigma.is_finite()) {
+            return sigma / gain;
+        }
+        for _ in 0..CLIP_ROUNDS {
+            // In units of the last σ̂, so that no square under- or overflows.
+            let (sum, kept) = parts
+                .iter()
+                .map(|v| v / sigma)
+                .filter(|u| *u <= CLIP)
+                .fold((0.0, 0usize), |(s, k), u| (s + u * u, k + 1));
+            if kept == 0 {
+                break;
+            }
+            sigma *= (sum / kept as f64 / spread.clipped_square()).sqrt();
+        }
+        sigma / gain
+    }
+
+    /// The lengths of the differences' parts off the local chord, in any dimension, and the
+    /// noise gain `√C(2k, k)` of the differences used (`None` below four points).
+    fn off_tangent_parts(&self) -> Option<(Vec<f64>, f64)> {
+        let (pts, closed) = (self.pts, self.closed);
+        let diffs = self.diffs.as_ref()?;
+        let count = diffs.differences.len();
+        // The differences without a chord are skipped; the vector is reserved whole (collected
+        // from a filter, it grew by doubling: a tenth of a 200-point fair's instructions went
+        // to growing the vectors here).
+        let part = |i: usize| {
+            let chord = diffs.chord(pts, closed, i);
+            let len = length(&chord);
+            (len > 0.0).then(|| off_axis(&diffs.differences[i], &chord) / len)
+        };
+        let mut normal_parts = Vec::with_capacity(count);
+        if count >= PARALLEL_FROM {
+            use rayon::prelude::*;
+            normal_parts.par_extend((0..count).into_par_iter().filter_map(part));
+        } else {
+            normal_parts.extend((0..count).filter_map(part));
+        }
+        Some((normal_parts, diffs.gain))
+    }
+
+    /// The lag-one correlation of the differences' parts off the local chord (as vectors):
+    /// see [`difference_correlation`].
+    pub(crate) fn correlation(&self) -> Option<f64> {
+        let (pts, closed) = (self.pts, self.closed);
+        let diffs = self.diffs.as_ref()?;
+        let count = diffs.differences.len();
+        // The unit chord by `hypot`, so that coordinates of any size neither over- nor
+        // underflow.
+        let part = |i: usize| -> [f64; D] {
+            let c = diffs.chord(pts, closed, i);
+            let len = length(&c);
+            let d = &diffs.differences[i];
+            if !(len > 0.0 && len.is_finite()) {
+                return [0.0; D];
+            }
+            let u: [f64; D] = std::array::from_fn(|x| c[x] / len);
+            let along = d.iter().zip(&u).map(|(a, b)| a * b).sum::<f64>();
+            std::array::from_fn(|x| d[x] - along * u[x])
+        };
+        let parts: Vec<[f64; D]> = map_indices(count, part);
+        // In units of the largest part, so that no square under- or overflows.
+        let top = parts
+            .iter()
+            .flat_map(|e| e.iter().map(|v| v.abs()))
+            .fold(0.0_f64, f64::max);
+        if !(top > 0.0 && top.is_finite()) {
+            return None;
+        }
+        let dot =
+            |a: &[f64; D], b: &[f64; D]| (0..D).map(|x| (a[x] / top) * (b[x] / top)).sum::<f64>();
+        let pairs = if closed { count } else { count - 1 };
+        let lagged: f64 = (0..pairs)
+            .map(|i| dot(&parts[i], &parts[(i + 1) % count]))
+            .sum();
+        let total: f64 = parts.iter().map(|e| dot(e, e)).sum();
+        (total > 0.0).then(|| lagged / total)
+    }
 }
 
 /// The lag-one correlation of the differences' parts off the local chord (those [`noise_sigma`]
@@ -358,37 +424,7 @@ fn off_tangent_parts<const D: usize>(pts: &[[f64; D]], closed: bool) -> Option<(
 /// that σ̂ measures the curve's shape, not noise. `None` below four points or when every part
 /// vanishes (points on a line, rounding-free samples of a low-degree polynomial).
 pub fn difference_correlation<const D: usize>(pts: &[[f64; D]], closed: bool) -> Option<f64> {
-    let diffs = Differences::of(pts, closed)?;
-    let count = diffs.differences.len();
-    // The unit chord by `hypot`, so that coordinates of any size neither over- nor
-    // underflow.
-    let part = |i: usize| -> [f64; D] {
-        let c = diffs.chord(pts, closed, i);
-        let len = length(&c);
-        let d = &diffs.differences[i];
-        if !(len > 0.0 && len.is_finite()) {
-            return [0.0; D];
-        }
-        let u: [f64; D] = std::array::from_fn(|x| c[x] / len);
-        let along = d.iter().zip(&u).map(|(a, b)| a * b).sum::<f64>();
-        std::array::from_fn(|x| d[x] - along * u[x])
-    };
-    let parts: Vec<[f64; D]> = map_indices(count, part);
-    // In units of the largest part, so that no square under- or overflows.
-    let top = parts
-        .iter()
-        .flat_map(|e| e.iter().map(|v| v.abs()))
-        .fold(0.0_f64, f64::max);
-    if !(top > 0.0 && top.is_finite()) {
-        return None;
-    }
-    let dot = |a: &[f64; D], b: &[f64; D]| (0..D).map(|x| (a[x] / top) * (b[x] / top)).sum::<f64>();
-    let pairs = if closed { count } else { count - 1 };
-    let lagged: f64 = (0..pairs)
-        .map(|i| dot(&parts[i], &parts[(i + 1) % count]))
-        .sum();
-    let total: f64 = parts.iter().map(|e| dot(e, e)).sum();
-    (total > 0.0).then(|| lagged / total)
+    NoiseMeasure::of(pts, closed).correlation()
 }
 
 /// The median of `v` (the upper one for an even count; 0 when empty), reordering it.
@@ -551,7 +587,7 @@ mod tests {
 
     /// The median's estimate alone, as σ̂ was taken before the clipped mean square.
     fn median_only(pts: &[[f64; 2]]) -> f64 {
-        let (mut parts, gain) = off_tangent_parts(pts, false).unwrap();
+        let (mut parts, gain) = NoiseMeasure::of(pts, false).off_tangent_parts().unwrap();
         MAD_TO_SIGMA * median(&mut parts) / gain
     }
 
@@ -601,7 +637,7 @@ mod tests {
         let xy: Vec<Point> = pts.iter().map(|p| Point::new(p[0], p[1])).collect();
         let est = noise_sigma(&xy, false);
         assert!((est / sigma - 1.0).abs() < 0.15, "σ̂ = {est}");
-        let (parts, gain) = off_tangent_parts(&pts, false).unwrap();
+        let (parts, gain) = NoiseMeasure::of(&pts, false).off_tangent_parts().unwrap();
         let rms = (parts.iter().map(|v| v * v).sum::<f64>() / parts.len() as f64).sqrt() / gain;
         assert!(rms > 2.0 * sigma, "plain mean square {rms}");
     }

@@ -118,6 +118,8 @@ pub(crate) fn unit_options(
 ) -> Result<FairOptions> {
     let mut opts = m.params_at_scale(options, s)?;
     opts.tolerance = options.tolerance.map(|t| t / s);
+    // σ̂ of the data, not of these coordinates: the method measures its own.
+    opts.measured_noise = None;
     Ok(opts)
 }
 

@@ -98,7 +98,7 @@ pub use space::{
     FairedSpace, SPACE_METHODS, SpaceFairReport, SpaceOutcome, check_space_method, fair_space,
 };
 
-use crate::analysis::{FairnessMetrics, difference_correlation, displacement, noise_sigma};
+use crate::analysis::{FairnessMetrics, NoiseMeasure, Spread, displacement};
 use crate::error::{Error, Result};
 use crate::geom::{Point, PointSeq, SpaceSeq, Vec2};
 use crate::spline::BSplineCurve;
@@ -378,17 +378,18 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
     let unit_scale = crate::geom::unit_scale(input.points());
     let before = FairnessMetrics::of_seq(&in_unit(input, unit_scale))?;
     let start = Instant::now();
-    let sigma = noise_sigma(input.points(), input.is_closed());
+    let xy: Vec<[f64; 2]> = input.points().iter().map(|p| [p.x, p.y]).collect();
+    let noise = NoiseMeasure::of(&xy, input.is_closed());
+    let sigma = noise.sigma(Spread::OneD);
     let (resolved, source) =
         resolve_tolerance(m, options, sigma, input.bbox().diagonal(), input.len())?;
     let mut resolved = resolved;
     let unchanged = left_as_is(&resolved, source, input.len(), input.is_closed(), || {
-        input
-            .points()
-            .iter()
-            .map(|p| [p.x, p.y])
-            .collect::<Vec<_>>()
+        noise.correlation()
     });
+    drop(noise);
+    drop(xy);
+    resolved.measured_noise = Some(sigma);
     let outcome = if let Some(note) = unchanged {
         Outcome {
             points: input.points().to_vec(),
@@ -446,8 +447,8 @@ pub(crate) const NO_NOISE_CORRELATION: f64 = 0.5;
 /// so. σ̂ then measures the curve's own shape, and a band of `k·σ̂` would only move a clean
 /// curve towards the energy's optimum (the bundled `sine-truth.csv`: its curvature error
 /// against the truth went from 0.0059 to 0.0093, its end inflections lost).
-fn no_noise<const D: usize>(pts: &[[f64; D]], closed: bool) -> Option<String> {
-    let r = difference_correlation(pts, closed)?;
+fn no_noise(correlation: Option<f64>) -> Option<String> {
+    let r = correlation?;
     (r > NO_NOISE_CORRELATION).then(|| {
         format!(
             "--tolerance auto found no noise: the differences it measures the noise by vary \
@@ -514,16 +515,16 @@ fn run_widening<O>(
 /// Why the input comes back as it is without running the method, if it does: every point
 /// held ([`all_held`]), or an automatic tolerance that finds no noise ([`no_noise`]; `pts`
 /// gives the points, asked for only then).
-fn left_as_is<P: AsRef<[[f64; D]]>, const D: usize>(
+fn left_as_is(
     options: &FairOptions,
     source: Option<ToleranceSource>,
     n: usize,
     closed: bool,
-    pts: impl FnOnce() -> P,
+    correlation: impl FnOnce() -> Option<f64>,
 ) -> Option<String> {
     all_held(options, n, closed).or_else(|| {
         (source == Some(ToleranceSource::Auto))
-            .then(|| no_noise(pts().as_ref(), closed))
+            .then(|| no_noise(correlation()))
             .flatten()
     })
 }

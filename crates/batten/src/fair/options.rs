@@ -60,6 +60,13 @@ pub struct FairOptions {
     ///
     /// Default value: `true`.
     pub keep_clean: bool,
+    /// σ̂ of the input ([`crate::analysis::noise_sigma`], or `noise_sigma_space` for a space
+    /// curve), as the common path ([`super::fair_with`], [`super::fair_space`]) measured it
+    /// for the report and the automatic tolerance, so that a method that needs it (`band`'s
+    /// debiasing stage) does not measure it again, once per widening round. Set only there,
+    /// for the input the method is given; `None` elsewhere and for runs on rescaled
+    /// coordinates, where the method measures it itself.
+    pub(crate) measured_noise: Option<f64>,
 }
 
 impl FairOptions {
@@ -72,6 +79,7 @@ impl FairOptions {
         max_iterations: None,
         params: BTreeMap::new(),
         keep_clean: true,
+        measured_noise: None,
     };
 
     /// Set the tolerance (largest allowed point displacement, data units).

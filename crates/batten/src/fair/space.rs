@@ -13,7 +13,7 @@ use super::{
     EndFix, FairMethod, FairOptions, FairStatus, HistoryRow, Outcome, SolverInfo, ToleranceSource,
     guard,
 };
-use crate::analysis::{Displacement, SpaceMetrics, noise_sigma_space};
+use crate::analysis::{Displacement, NoiseMeasure, SpaceMetrics, Spread};
 use crate::error::{Error, Result};
 use crate::geom::{SpaceSeq, Xyz, unit_scale_xyz};
 
@@ -137,11 +137,16 @@ pub fn fair_space(name: &str, input: &SpaceSeq, options: &FairOptions) -> Result
     let before = SpaceMetrics::of_seq(&scaled_seq(input, 1.0 / unit_scale)?)?;
     let start = Instant::now();
     let closed = input.is_closed();
-    let sigma = noise_sigma_space(input.points(), closed);
+    let noise = NoiseMeasure::of(input.points(), closed);
+    let sigma = noise.sigma(Spread::of_space(input.points()));
     let (resolved, source) =
         super::resolve_tolerance(m, options, sigma, input.scale(), input.len())?;
     let mut resolved = resolved;
-    let unchanged = super::left_as_is(&resolved, source, input.len(), closed, || input.points());
+    let unchanged = super::left_as_is(&resolved, source, input.len(), closed, || {
+        noise.correlation()
+    });
+    drop(noise);
+    resolved.measured_noise = Some(sigma);
     let outcome = if let Some(note) = unchanged {
         SpaceOutcome {
             points: input.points().to_vec(),

@@ -146,7 +146,10 @@ impl FairMethod for Band {
         let pts: Vec<[f64; 2]> = input.points().iter().map(|p| [p.x, p.y]).collect();
         let closed = input.is_closed();
         let (faired, mut outcome) = run_points(&pts, closed, options, || {
-            (crate::analysis::noise_sigma(input.points(), closed), 2)
+            let sigma = options
+                .measured_noise
+                .unwrap_or_else(|| crate::analysis::noise_sigma(input.points(), closed));
+            (sigma, 2)
         })?;
         outcome.points = faired.iter().map(|q| Point::new(q[0], q[1])).collect();
         Ok(outcome)
@@ -161,7 +164,10 @@ impl FairMethod for Band {
             } else {
                 3
             };
-            (crate::analysis::noise_sigma_space(pts, closed), dims)
+            let sigma = options
+                .measured_noise
+                .unwrap_or_else(|| crate::analysis::noise_sigma_space(pts, closed));
+            (sigma, dims)
         });
         Some(run.map(|(points, outcome)| SpaceOutcome::from_parts(points, outcome)))
     }
