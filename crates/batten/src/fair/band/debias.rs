@@ -23,7 +23,11 @@
 use super::design::{Design, SplineMap};
 use super::energy::Energy;
 use crate::error::Result;
-use crate::numeric::{CyclicSymBanded, SymBanded};
+use crate::numeric::{CyclicSymBanded, PARALLEL_FROM, SymBanded, map_indices};
+use rayon::prelude::*;
+
+/// Points a task of [`Windows::significant`] scans.
+const SIGNIFICANT_CHUNK: usize = 1 << 14;
 
 /// The most the debiased energy may exceed the passes' optimum, as a factor.
 pub(super) const ENERGY_CAP: f64 = 4.0;
@@ -432,26 +436,16 @@ impl<'a, const D: usize> Penalized<'a, D> {
         for _ in 0..LOCAL_ROUNDS {
             // The residual (zero at held points, which the minimiser leaves at their centres).
             let flat = self.residual(&y);
-            let residual: Vec<[f64; D]> = (0..n)
-                .map(|i| std::array::from_fn(|a| flat[i * D + a]))
-                .collect();
-            let windows = Windows::new(&residual, self.pinned, self.energy.closed);
+            let windows = Windows::<D>::new(&flat, self.pinned, self.energy.closed);
+            let marked = windows.significant(&weights, self.unit, threshold);
+            if marked.iter().all(|h| *h == 0) {
+                break;
+            }
             let mut raise = Marks::new(n, self.energy.closed);
-            let mut any = false;
-            for i in 0..n {
-                let half = windows.half_width((weights[i] / self.unit).powf(-1.0 / 6.0));
-                let (sum, count) = windows.sum(i, half);
-                if count == 0 {
-                    continue;
-                }
-                let norm2: f64 = sum.iter().map(|s| s * s).sum::<f64>() / count as f64;
-                if norm2 > threshold {
-                    any = true;
+            for (i, &half) in marked.iter().enumerate() {
+                if half > 0 {
                     raise.mark(i, half);
                 }
-            }
-            if !any {
-                break;
             }
             let raise = raise.finish();
             let trial: Vec<f64> = weights
@@ -506,7 +500,12 @@ fn smooth_log_weights(weights: &[f64], unit: f64, closed: bool, lengths: f64) ->
     }
     // Prefix sums of the logarithms three times over, so that cyclic windows are plain
     // ranges (each logarithm taken once).
-    let logs: Vec<f64> = weights.iter().map(|w| w.ln()).collect();
+    // The weights come in runs of equal values: each run's logarithm and window taken once.
+    let logs: Vec<f64> = per_run(weights, |w| w.ln());
+    let halves: Vec<usize> = per_run(weights, |w| {
+        let length = lengths * (w / unit).powf(-1.0 / 6.0);
+        ((0.5 * length).round() as usize).clamp(1, (n / 2).max(1))
+    });
     let mut prefix = Vec::with_capacity(3 * n + 1);
     prefix.push(0.0);
     let mut acc = 0.0;
@@ -514,16 +513,29 @@ fn smooth_log_weights(weights: &[f64], unit: f64, closed: bool, lengths: f64) ->
         acc += logs[k % n];
         prefix.push(acc);
     }
-    (0..n)
-        .map(|i| {
-            let length = lengths * (weights[i] / unit).powf(-1.0 / 6.0);
-            let half = ((0.5 * length).round() as usize).clamp(1, (n / 2).max(1));
-            let (lo, hi) = if closed {
-                (n + i - half, n + i + half + 1)
-            } else {
-                (n + i.saturating_sub(half), n + (i + half + 1).min(n))
-            };
-            ((prefix[hi] - prefix[lo]) / (hi - lo) as f64).exp()
+    map_indices(n, |i| {
+        let half = halves[i];
+        let (lo, hi) = if closed {
+            (n + i - half, n + i + half + 1)
+        } else {
+            (n + i.saturating_sub(half), n + (i + half + 1).min(n))
+        };
+        ((prefix[hi] - prefix[lo]) / (hi - lo) as f64).exp()
+    })
+}
+
+/// `f(w)` for every weight, computed once for each run of equal weights.
+fn per_run<T: Copy>(weights: &[f64], f: impl Fn(f64) -> T) -> Vec<T> {
+    let mut last: Option<(f64, T)> = None;
+    weights
+        .iter()
+        .map(|&w| match last {
+            Some((lw, v)) if lw == w => v,
+            _ => {
+                let v = f(w);
+                last = Some((w, v));
+                v
+            }
         })
         .collect()
 }
@@ -612,13 +624,15 @@ struct Windows<const D: usize> {
 }
 
 impl<const D: usize> Windows<D> {
-    fn new(residual: &[[f64; D]], held: &[bool], closed: bool) -> Windows<D> {
-        let mut sums = Vec::with_capacity(residual.len() + 1);
-        let mut counts = Vec::with_capacity(residual.len() + 1);
+    /// The prefix sums of `residual` (flat, `D` numbers a point) over the points not `held`.
+    fn new(residual: &[f64], held: &[bool], closed: bool) -> Windows<D> {
+        let n = held.len();
+        let mut sums = Vec::with_capacity(n + 1);
+        let mut counts = Vec::with_capacity(n + 1);
         let (mut s, mut c) = ([0.0; D], 0);
         sums.push(s);
         counts.push(c);
-        for (e, h) in residual.iter().zip(held) {
+        for (e, h) in residual.chunks_exact(D).zip(held) {
             if !h {
                 for a in 0..D {
                     s[a] += e[a];
@@ -637,6 +651,49 @@ impl<const D: usize> Windows<D> {
 
     fn n(&self) -> usize {
         self.counts.len() - 1
+    }
+
+    /// For every point, the half-width of its window if the window's mean residual is
+    /// significant (`|sum|²/count > threshold`), else 0. The window of point `i` is its
+    /// smoothing length `(weights[i]/unit)^(−1/6)` points long ([`Penalized::local_weights`]).
+    /// In parallel pieces (each point on its own: the same marks whatever the split); the
+    /// half-width is computed once for each run of equal weights (the weights take a few
+    /// values, and a power per point was most of a round's time at 10⁶ points).
+    fn significant(&self, weights: &[f64], unit: f64, threshold: f64) -> Vec<usize> {
+        let n = self.n();
+        let mut marked = vec![0; n];
+        let piece = |from: usize, out: &mut [usize]| {
+            let mut last: Option<(f64, usize)> = None;
+            for (k, o) in out.iter_mut().enumerate() {
+                let i = from + k;
+                let w = weights[i];
+                let half = match last {
+                    Some((lw, h)) if lw == w => h,
+                    _ => {
+                        let h = self.half_width((w / unit).powf(-1.0 / 6.0));
+                        last = Some((w, h));
+                        h
+                    }
+                };
+                let (sum, count) = self.sum(i, half);
+                if count == 0 {
+                    continue;
+                }
+                let norm2: f64 = sum.iter().map(|s| s * s).sum::<f64>() / count as f64;
+                if norm2 > threshold {
+                    *o = half;
+                }
+            }
+        };
+        if n >= PARALLEL_FROM {
+            marked
+                .par_chunks_mut(SIGNIFICANT_CHUNK)
+                .enumerate()
+                .for_each(|(c, out)| piece(c * SIGNIFICANT_CHUNK, out));
+        } else {
+            piece(0, &mut marked);
+        }
+        marked
     }
 
     /// The half-width of a window `length` points long: at least 2, and the window no longer
@@ -814,7 +871,7 @@ mod tests {
                     .map(|i| [(i as f64 * 0.7).sin(), (i as f64 * 1.3).cos()])
                     .collect();
                 let held: Vec<bool> = (0..n).map(|i| i % 5 == 1).collect();
-                let windows = Windows::new(&residual, &held, closed);
+                let windows = Windows::<2>::new(residual.as_flattened(), &held, closed);
                 for length in [0.0, 3.0, 6.0, 11.0, 100.0] {
                     let half = windows.half_width(length);
                     assert!(2 * half < n + usize::from(!closed), "{n} {half}");
@@ -835,6 +892,43 @@ mod tests {
                         }
                     }
                 }
+            }
+        }
+    }
+
+    /// The parallel scan for significant windows marks what the per-point rule marks, with
+    /// weights in runs (as the rounds leave them) and unevenly, open and closed, below and
+    /// above the size from which it runs in pieces.
+    #[test]
+    fn significant_windows_match_the_per_point_rule() {
+        for closed in [false, true] {
+            for n in [50, PARALLEL_FROM + 1234] {
+                let residual: Vec<f64> = (0..2 * n)
+                    .map(|k| (k as f64 * 0.37).sin() + 0.6 * ((k / 2) as f64 * 0.02).sin())
+                    .collect();
+                let held: Vec<bool> = (0..n).map(|i| i % 97 == 3).collect();
+                let unit = 1.0;
+                let weights: Vec<f64> = (0..n)
+                    .map(|i| {
+                        if i % 7 == 0 {
+                            1e-3 * (1.0 + i as f64 / n as f64)
+                        } else {
+                            1e-4 * 4.0_f64.powi(((i / 1000) % 3) as i32)
+                        }
+                    })
+                    .collect();
+                let windows = Windows::<2>::new(&residual, &held, closed);
+                let threshold = 1.0;
+                let got = windows.significant(&weights, unit, threshold);
+                let mut count = 0;
+                for i in 0..n {
+                    let half = windows.half_width((weights[i] / unit).powf(-1.0 / 6.0));
+                    let (sum, c) = windows.sum(i, half);
+                    let hit = c > 0 && (sum[0] * sum[0] + sum[1] * sum[1]) / c as f64 > threshold;
+                    assert_eq!(got[i], if hit { half } else { 0 }, "{closed} {n} {i}");
+                    count += usize::from(hit);
+                }
+                assert!(count > 0 && count < n, "{count} of {n}");
             }
         }
     }

@@ -21,6 +21,7 @@
 //! added to the parameters that wrap.
 
 use super::spline::Span;
+use crate::numeric::map_indices;
 
 /// The shortest parameter step, relative to the mean chord: points of an iterate that (nearly)
 /// coincide would give divided differences of unbounded size.
@@ -67,13 +68,11 @@ pub(super) struct Energy<const D: usize> {
 /// The chord lengths of `shape`, cyclic when closed.
 pub(super) fn chords_of<const D: usize>(shape: &[[f64; D]], closed: bool) -> Vec<f64> {
     let n = shape.len();
-    (0..if closed { n } else { n - 1 })
-        .map(|i| {
-            (0..D).fold(0.0_f64, |acc, a| {
-                acc.hypot(shape[i][a] - shape[(i + 1) % n][a])
-            })
-        })
-        .collect()
+    // From the first coordinate's size (what `hypot(0, x)` gives): one `hypot` fewer.
+    map_indices(if closed { n } else { n - 1 }, |i| {
+        let (p, q) = (&shape[i], &shape[(i + 1) % n]);
+        (1..D).fold((p[0] - q[0]).abs(), |acc, a| acc.hypot(p[a] - q[a]))
+    })
 }
 
 /// The parameters of steps `chords`: their running sums from 0, in units of the mean step,

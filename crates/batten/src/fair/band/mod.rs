@@ -69,6 +69,7 @@ use crate::fair::{
     SolverInfo, SpaceOutcome,
 };
 use crate::geom::{Point, PointSeq, SpaceSeq};
+use crate::numeric::map_indices;
 
 use debias::{ENERGY_CAP, Penalized};
 use energy::{Energy, Metric};
@@ -358,10 +359,10 @@ fn fair_points<const D: usize>(
             fidelity = Some((mu / form.unit(), raised));
         }
     }
-    let on_edge = shape
-        .iter()
-        .zip(pts)
-        .filter(|(q, p)| distance(q, p) >= (1.0 - BAND_EDGE_REL) * tolerance)
+    let edge = (1.0 - BAND_EDGE_REL) * tolerance;
+    let on_edge = map_indices(n, |i| distance(&shape[i], &pts[i]) >= edge)
+        .into_iter()
+        .filter(|e| *e)
         .count();
     Ok(Faired {
         points: shape,
@@ -538,7 +539,7 @@ fn farthest<const D: usize>(shape: &[[f64; D]], pts: &[[f64; D]]) -> f64 {
 /// the points.
 fn parameter_window<const D: usize>(pts: &[[f64; D]], tolerance: f64) -> usize {
     let n = pts.len();
-    let mut chords: Vec<f64> = (0..n - 1).map(|i| distance(&pts[i], &pts[i + 1])).collect();
+    let mut chords: Vec<f64> = map_indices(n - 1, |i| distance(&pts[i], &pts[i + 1]));
     let mid = chords.len() / 2;
     let h = *chords.select_nth_unstable_by(mid, f64::total_cmp).1;
     if h > 0.0 {
@@ -557,7 +558,7 @@ fn dense_parameter_window<const D: usize>(pts: &[[f64; D]], closed: bool, tolera
     let mut m = parameter_window(pts, tolerance);
     for _ in 0..DENSE_WINDOW_ROUNDS {
         let s = moving_average(pts, closed, m);
-        let mut chords: Vec<f64> = (0..n - 1).map(|i| distance(&s[i], &s[i + 1])).collect();
+        let mut chords: Vec<f64> = map_indices(n - 1, |i| distance(&s[i], &s[i + 1]));
         let mid = chords.len() / 2;
         let h = *chords.select_nth_unstable_by(mid, f64::total_cmp).1;
         if h <= 0.0 {
@@ -590,22 +591,20 @@ fn moving_average<const D: usize>(pts: &[[f64; D]], closed: bool, m: usize) -> V
             prefix[j + 1][a] = prefix[j][a] + p[a];
         }
     }
-    (0..n)
-        .map(|i| {
-            let (lo, hi) = if closed {
-                (i, i + 2 * m)
-            } else {
-                let half = i.min(n - 1 - i).min(m);
-                (i - half, i + half)
-            };
-            let count = (hi - lo + 1) as f64;
-            let mut acc = [0.0; D];
-            for a in 0..D {
-                acc[a] = (prefix[hi + 1][a] - prefix[lo][a]) / count;
-            }
-            acc
-        })
-        .collect()
+    map_indices(n, |i| {
+        let (lo, hi) = if closed {
+            (i, i + 2 * m)
+        } else {
+            let half = i.min(n - 1 - i).min(m);
+            (i - half, i + half)
+        };
+        let count = (hi - lo + 1) as f64;
+        let mut acc = [0.0; D];
+        for a in 0..D {
+            acc[a] = (prefix[hi + 1][a] - prefix[lo][a]) / count;
+        }
+        acc
+    })
 }
 
 /// The points whose chord lengths give the first pass its parameters: the input, averaged
@@ -653,42 +652,41 @@ fn smoothed_for_parameters<const D: usize>(
 /// bit for bit [`crate::Point::distance`]): the band's guarantee is checked by that measure, and a
 /// square root of the summed squares can differ from it in the last place.
 fn distance<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
-    (0..D).fold(0.0_f64, |acc, k| acc.hypot(a[k] - b[k]))
+    // From the first coordinate's size (what `hypot(0, x)` gives): one `hypot` fewer.
+    (1..D).fold((a[0] - b[0]).abs(), |acc, k| acc.hypot(a[k] - b[k]))
 }
 
 /// `q_i = p_i + D·r_i`, then pulled in where rounding put it a hair outside the band, so that
 /// `|q_i − p_i| ≤ D` holds exactly as computed: first scaled to the unit length if it is
 /// longer, then shortened by a cut that starts at a few units in the last place and doubles.
 fn into_band<const D: usize>(pts: &[[f64; D]], r: &[f64], tolerance: f64) -> Vec<[f64; D]> {
-    pts.iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let ri = &r[i * D..(i + 1) * D];
-            let len = ri.iter().map(|v| v * v).sum::<f64>().sqrt();
-            // Clearly inside, rounding of `q` and of its distance included (a few units in
-            // the last place of the coordinates and of `D`; 16 of them here): no check needed.
-            let size = p.iter().fold(tolerance, |m, v| m.max(v.abs()));
-            if len <= 1.0 - 16.0 * f64::EPSILON * (1.0 + size / tolerance) {
-                return std::array::from_fn(|a| p[a] + tolerance * ri[a]);
+    map_indices(pts.len(), |i| {
+        let p = &pts[i];
+        let ri = &r[i * D..(i + 1) * D];
+        let len = ri.iter().map(|v| v * v).sum::<f64>().sqrt();
+        // Clearly inside, rounding of `q` and of its distance included (a few units in
+        // the last place of the coordinates and of `D`; 16 of them here): no check needed.
+        let size = p.iter().fold(tolerance, |m, v| m.max(v.abs()));
+        if len <= 1.0 - 16.0 * f64::EPSILON * (1.0 + size / tolerance) {
+            return std::array::from_fn(|a| p[a] + tolerance * ri[a]);
+        }
+        let mut shrink = if len > 1.0 { 1.0 / len } else { 1.0 };
+        // Far from the origin the rounding of `q` is large against `D`: the cut doubles
+        // at each try, from 4 units in the last place.
+        let mut cut = 4.0 * f64::EPSILON;
+        for _ in 0..MAX_SHRINKS {
+            let mut q = *p;
+            for a in 0..D {
+                q[a] = p[a] + tolerance * (shrink * ri[a]);
             }
-            let mut shrink = if len > 1.0 { 1.0 / len } else { 1.0 };
-            // Far from the origin the rounding of `q` is large against `D`: the cut doubles
-            // at each try, from 4 units in the last place.
-            let mut cut = 4.0 * f64::EPSILON;
-            for _ in 0..MAX_SHRINKS {
-                let mut q = *p;
-                for a in 0..D {
-                    q[a] = p[a] + tolerance * (shrink * ri[a]);
-                }
-                if distance(&q, p) <= tolerance {
-                    return q;
-                }
-                shrink *= 1.0 - cut;
-                cut = (2.0 * cut).min(1.0);
+            if distance(&q, p) <= tolerance {
+                return q;
             }
-            *p
-        })
-        .collect()
+            shrink *= 1.0 - cut;
+            cut = (2.0 * cut).min(1.0);
+        }
+        *p
+    })
 }
 
 #[cfg(test)]
