@@ -217,6 +217,15 @@ pub trait FairMethod: Sync {
         true
     }
 
+    /// Whether the method checks its single moves against the input's own fairness (the
+    /// per-move part of the clean-curve guard, [`FairOptions::keep_clean`], which applies only
+    /// to an input without inflections or vibrations): the common path then measures the
+    /// input before the method runs. `true` (the default); methods without such a check
+    /// return `false`, and the input is measured while they run.
+    fn checks_moves(&self) -> bool {
+        true
+    }
+
     /// The method's parameters given in data units, as `(name, power of length)` pairs: the
     /// default [`params_at_scale`](FairMethod::params_at_scale) and
     /// [`report_params_at_scale`](FairMethod::report_params_at_scale) convert them. The
@@ -376,7 +385,56 @@ pub fn fair(name: &str, input: &PointSeq, options: &FairOptions) -> Result<Faire
 pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) -> Result<Faired> {
     check_options(m, input.is_closed(), options)?;
     let unit_scale = crate::geom::unit_scale(input.points());
-    let before = FairnessMetrics::of_seq(&in_unit(input, unit_scale))?;
+    let measure = || FairnessMetrics::of_seq(&in_unit(input, unit_scale));
+    let (before, ran) = if m.checks_moves() {
+        let before = measure()?;
+        let ran = run_method(m, input, options, Some(&before));
+        (before, ran)
+    } else {
+        // The input's measures and the method are independent: the measures' parallel
+        // pieces take the core a method's serial solve leaves idle.
+        let (before, ran) = rayon::join(measure, || run_method(m, input, options, None));
+        (before?, ran)
+    };
+    let Ran {
+        outcome,
+        options,
+        start,
+        source,
+        sigma,
+    } = ran?;
+    finish(
+        m,
+        (input, None),
+        (before, unit_scale),
+        &options,
+        outcome,
+        start,
+        (source, Some(sigma)),
+    )
+}
+
+/// What a method's run did (`run_method` here and in `space.rs`): the method's outcome,
+/// the options with the tolerance it used, when it started (the noise estimate counts),
+/// where the tolerance came from, and σ̂.
+struct Ran<O> {
+    outcome: O,
+    options: FairOptions,
+    start: Instant,
+    source: Option<ToleranceSource>,
+    sigma: f64,
+}
+
+/// The noise estimate, the tolerance, and the method's run on `input` (widened where an
+/// automatic tolerance proves too narrow), unless the input is to be left as it is. `before`,
+/// the input's measures, is given to methods that check single moves against it
+/// ([`FairMethod::checks_moves`]).
+fn run_method(
+    m: &dyn FairMethod,
+    input: &PointSeq,
+    options: &FairOptions,
+    before: Option<&FairnessMetrics>,
+) -> Result<Ran<Outcome>> {
     let start = Instant::now();
     let xy: Vec<[f64; 2]> = input.points().iter().map(|p| [p.x, p.y]).collect();
     let noise = NoiseMeasure::of(&xy, input.is_closed());
@@ -400,7 +458,10 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
     } else {
         let s = guard::method_scale(input);
         let run = |options: &FairOptions| -> Result<Outcome> {
-            let run_options = guard::per_move_options(options, &before);
+            let run_options = match before {
+                Some(before) => guard::per_move_options(options, before),
+                None => options.clone(),
+            };
             if s == 1.0 {
                 m.run(input, &run_options)
             } else {
@@ -415,16 +476,13 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
         outcome.notes.extend(note);
         outcome
     };
-    let options = &resolved;
-    finish(
-        m,
-        (input, None),
-        (before, unit_scale),
-        options,
+    Ok(Ran {
         outcome,
+        options: resolved,
         start,
-        (source, Some(sigma)),
-    )
+        source,
+        sigma,
+    })
 }
 
 /// The smallest automatic tolerance, relative to the bounding-box diagonal: below it the

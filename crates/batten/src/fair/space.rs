@@ -10,8 +10,8 @@ use serde_json::{Map, Value};
 use std::time::Instant;
 
 use super::{
-    EndFix, FairMethod, FairOptions, FairStatus, HistoryRow, Outcome, SolverInfo, ToleranceSource,
-    guard,
+    EndFix, FairMethod, FairOptions, FairStatus, HistoryRow, Outcome, Ran, SolverInfo,
+    ToleranceSource, guard,
 };
 use crate::analysis::{Displacement, NoiseMeasure, SpaceMetrics, Spread};
 use crate::error::{Error, Result};
@@ -134,7 +134,40 @@ pub fn fair_space(name: &str, input: &SpaceSeq, options: &FairOptions) -> Result
     }
     super::check_options(m, input.is_closed(), options)?;
     let unit_scale = unit_scale_xyz(input.points());
-    let before = SpaceMetrics::of_seq(&scaled_seq(input, 1.0 / unit_scale)?)?;
+    // The input's measures and the method are independent (no space method checks single
+    // moves): the measures take the core a method's serial solve leaves idle.
+    let (before, ran) = rayon::join(
+        || SpaceMetrics::of_seq(&scaled_seq(input, 1.0 / unit_scale)?),
+        || run_method(m, input, options, unit_scale),
+    );
+    let before = before?;
+    let Ran {
+        outcome,
+        options,
+        start,
+        source,
+        sigma,
+    } = ran?;
+    finish_space(
+        m,
+        input,
+        (before, unit_scale),
+        &options,
+        outcome,
+        start,
+        (source, sigma),
+    )
+}
+
+/// The noise estimate, the tolerance and the method's run on `input` (widened where an
+/// automatic tolerance proves too narrow), unless the input is to be left as it is;
+/// `unit_scale` is the input's ([`unit_scale_xyz`]).
+fn run_method(
+    m: &dyn FairMethod,
+    input: &SpaceSeq,
+    options: &FairOptions,
+    unit_scale: f64,
+) -> Result<Ran<SpaceOutcome>> {
     let start = Instant::now();
     let closed = input.is_closed();
     let noise = NoiseMeasure::of(input.points(), closed);
@@ -173,16 +206,13 @@ pub fn fair_space(name: &str, input: &SpaceSeq, options: &FairOptions) -> Result
         outcome.notes.extend(note);
         outcome
     };
-    let options = &resolved;
-    finish_space(
-        m,
-        input,
-        (before, unit_scale),
-        options,
+    Ok(Ran {
         outcome,
+        options: resolved,
         start,
-        (source, sigma),
-    )
+        source,
+        sigma,
+    })
 }
 
 /// [`FairMethod::run_space`], or [`Error::PlanarOnly`] where the method has none.

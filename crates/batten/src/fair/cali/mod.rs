@@ -191,6 +191,11 @@ fn cali_params(options: &FairOptions) -> Result<(f64, f64, usize)> {
 }
 
 impl FairMethod for Cali {
+    /// No per-move check: the input is measured while the method runs.
+    fn checks_moves(&self) -> bool {
+        false
+    }
+
     fn name(&self) -> &'static str {
         "cali"
     }

@@ -70,6 +70,11 @@ use run::run_points;
 pub struct Kuragano;
 
 impl FairMethod for Kuragano {
+    /// No per-move check: the input is measured while the method runs.
+    fn checks_moves(&self) -> bool {
+        false
+    }
+
     fn name(&self) -> &'static str {
         "kuragano"
     }

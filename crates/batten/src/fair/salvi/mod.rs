@@ -112,6 +112,11 @@ pub use target::{MAX_SAMPLES, Smoother};
 pub struct Salvi;
 
 impl FairMethod for Salvi {
+    /// No per-move check: the input is measured while the method runs.
+    fn checks_moves(&self) -> bool {
+        false
+    }
+
     fn name(&self) -> &'static str {
         "salvi"
     }
