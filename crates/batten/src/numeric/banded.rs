@@ -56,6 +56,15 @@ impl SymBanded {
         self.band[i * (self.bw + 1) + (i - j)] += v;
     }
 
+    /// Add `v` to `A[i][j]` for `j ≤ i ≤ j + bw` (the lower band), for assembly loops that
+    /// know their indices are in the band: [`SymBanded::add`] without its checks (debug
+    /// builds keep them).
+    #[inline]
+    pub(crate) fn add_lower(&mut self, i: usize, j: usize, v: f64) {
+        debug_assert!(!self.factored && j <= i && i - j <= self.bw);
+        self.band[i * (self.bw + 1) + (i - j)] += v;
+    }
+
     /// Factorise as `L D Lᵀ` (L unit lower triangular, banded). No pivoting: meant for
     /// symmetric positive definite matrices.
     ///

@@ -175,12 +175,19 @@ impl Newton {
             Newton::Open { base, work } => {
                 work.assign(base);
                 let mut top = 0.0_f64;
-                p.design
-                    .for_each_block_lower::<D>(blocks, p.pinned, |r, c, v| {
-                        if !held[r / D] && !held[c / D] {
-                            work.add(r, c, v);
-                        }
-                    });
+                match p.design {
+                    Design::Spline(map) => {
+                        map.add_blocks_open::<D>(blocks, p.pinned, held, work);
+                    }
+                    Design::Points { .. } => {
+                        p.design
+                            .for_each_block_lower::<D>(blocks, p.pinned, |r, c, v| {
+                                if !held[r / D] && !held[c / D] {
+                                    work.add(r, c, v);
+                                }
+                            });
+                    }
+                }
                 for k in 0..work.n() {
                     top = top.max(work.get(k, k));
                 }

@@ -26,6 +26,7 @@
 use super::design::{Design, SplineMap};
 use super::energy::Energy;
 use crate::error::Result;
+use crate::numeric::map_indices;
 use crate::spline::{MAX_ORDER, basis_derivs};
 
 use super::debias::Penalized;
@@ -100,15 +101,16 @@ impl Layout {
         let mut u = vec![0.0; 4];
         u.extend((1..spans).map(|k| k as f64 * h));
         u.extend([end; 4]);
-        let mut first = Vec::with_capacity(t.len());
-        let mut basis = Vec::with_capacity(t.len());
-        let mut out = [[0.0; MAX_ORDER]; 4];
-        for &ti in t {
+        // Each point on its own (in parallel pieces on long curves: the same values).
+        let (first, basis): (Vec<usize>, Vec<[f64; 4]>) = map_indices(t.len(), |i| {
+            let ti = t[i];
+            let mut out = [[0.0; MAX_ORDER]; 4];
             let s = ((ti / h).floor().max(0.0) as usize).min(spans - 1);
             basis_derivs(&u, 3, s + 3, ti, 0, &mut out);
-            first.push(s);
-            basis.push([out[0][0], out[0][1], out[0][2], out[0][3]]);
-        }
+            (s, [out[0][0], out[0][1], out[0][2], out[0][3]])
+        })
+        .into_iter()
+        .unzip();
         let spans_coef = (0..spans)
             .map(|s| {
                 let e = |l: usize| -> [f64; 4] { std::array::from_fn(|k| f64::from(k == l)) };
@@ -143,21 +145,21 @@ impl Layout {
 
     fn periodic(t: &[f64], period: f64, spans: usize) -> Layout {
         let h = period / spans as f64;
-        let mut first = Vec::with_capacity(t.len());
-        let mut basis = Vec::with_capacity(t.len());
-        for &ti in t {
-            let v = ti / h;
+        let (first, basis): (Vec<usize>, Vec<[f64; 4]>) = map_indices(t.len(), |i| {
+            let v = t[i] / h;
             let s = (v.floor().max(0.0) as usize).min(spans - 1);
             let u = (v - s as f64).clamp(0.0, 1.0);
             let w = 1.0 - u;
-            first.push(s);
-            basis.push([
+            let b = [
                 w * w * w / 6.0,
                 (3.0 * u * u * u - 6.0 * u * u + 4.0) / 6.0,
                 (-3.0 * u * u * u + 3.0 * u * u + 3.0 * u + 1.0) / 6.0,
                 u * u * u / 6.0,
-            ]);
-        }
+            ];
+            (s, b)
+        })
+        .into_iter()
+        .unzip();
         let c = 1.0 / (6.0 * h * h * h);
         // `C''` of the uniform cubic basis at the span's ends (u = 0 and 1), over h².
         let d = 1.0 / (h * h);
@@ -212,12 +214,14 @@ pub(super) fn feasible_fit<const D: usize>(
             break;
         };
         let r = fit.residual(&x);
-        let mut farthest = 0.0_f64;
-        for (i, w) in weights.iter_mut().enumerate() {
-            let len = (0..D)
+        let lengths = map_indices(weights.len(), |i| {
+            (0..D)
                 .map(|a| r[i * D + a] * r[i * D + a])
                 .sum::<f64>()
-                .sqrt();
+                .sqrt()
+        });
+        let mut farthest = 0.0_f64;
+        for (w, (i, &len)) in weights.iter_mut().zip(lengths.iter().enumerate()) {
             farthest = farthest.max(len);
             if len > START_RADIUS {
                 if *w == mu {
