@@ -73,7 +73,11 @@ impl SymBanded {
     pub fn factorize(&mut self) -> Result<()> {
         let (n, w) = (self.n, self.bw + 1);
         let scale = (0..n).fold(0.0_f64, |m, i| m.max(self.band[i * w].abs()));
-        for i in 0..n {
+        let head = match self.bw {
+            7 | 11 => n.min(self.bw),
+            _ => n,
+        };
+        for i in 0..head {
             // For j in i-bw..i: L[i][j] = (A[i][j] - sum_k L[i][k] D[k] L[j][k]) / D[j]
             let lo = i.saturating_sub(self.bw);
             for j in lo..i {
@@ -89,14 +93,40 @@ impl SymBanded {
                 let l = self.band[i * w + (i - k)];
                 d -= l * l * self.band[k * w];
             }
-            if d.is_nan() || d <= PIVOT_REL * scale || !d.is_finite() {
-                return Err(Error::Singular(format!(
-                    "band matrix is not positive definite (pivot {i})"
-                )));
-            }
-            self.band[i * w] = d;
+            self.band[i * w] = checked_pivot(d, scale, i)?;
+        }
+        match self.bw {
+            7 => self.factorize_rows_fixed::<7>(head, scale)?,
+            11 => self.factorize_rows_fixed::<11>(head, scale)?,
+            _ => {}
         }
         self.factored = true;
+        Ok(())
+    }
+
+    /// The rows from `from` (at least `BW`) of [`SymBanded::factorize`] for a half-bandwidth
+    /// known at compile time: loops of fixed length over a fixed window, the same operations
+    /// in the same order.
+    fn factorize_rows_fixed<const BW: usize>(&mut self, from: usize, scale: f64) -> Result<()> {
+        let w = BW + 1;
+        for i in from..self.n {
+            let lo = i - BW;
+            let win = &mut self.band[lo * w..(i + 1) * w];
+            let row = BW * w;
+            for jj in 0..BW {
+                let mut s = win[row + (BW - jj)];
+                for kk in 0..jj {
+                    s -= win[row + (BW - kk)] * win[kk * w] * win[jj * w + (jj - kk)];
+                }
+                win[row + (BW - jj)] = s / win[jj * w];
+            }
+            let mut d = win[row];
+            for kk in 0..BW {
+                let l = win[row + (BW - kk)];
+                d -= l * l * win[kk * w];
+            }
+            win[row] = checked_pivot(d, scale, i)?;
+        }
         Ok(())
     }
 
@@ -327,9 +357,47 @@ impl SymBanded {
     }
 }
 
+/// A pivot of [`SymBanded::factorize`], or the error when it is (relatively) zero,
+/// negative or not finite.
+fn checked_pivot(d: f64, scale: f64, i: usize) -> Result<f64> {
+    if d.is_nan() || d <= PIVOT_REL * scale || !d.is_finite() {
+        return Err(Error::Singular(format!(
+            "band matrix is not positive definite (pivot {i})"
+        )));
+    }
+    Ok(d)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    impl SymBanded {
+        /// The general loops of [`SymBanded::factorize`], whatever the bandwidth (the
+        /// reference of the fixed-bandwidth path).
+        fn bw_general_factorize(&mut self) {
+            let (n, w) = (self.n, self.bw + 1);
+            for i in 0..n {
+                let lo = i.saturating_sub(self.bw);
+                for j in lo..i {
+                    let mut s = self.band[i * w + (i - j)];
+                    let klo = lo.max(j.saturating_sub(self.bw));
+                    for k in klo..j {
+                        s -= self.band[i * w + (i - k)]
+                            * self.band[k * w]
+                            * self.band[j * w + (j - k)];
+                    }
+                    self.band[i * w + (i - j)] = s / self.band[j * w];
+                }
+                let mut d = self.band[i * w];
+                for k in lo..i {
+                    let l = self.band[i * w + (i - k)];
+                    d -= l * l * self.band[k * w];
+                }
+                self.band[i * w] = d;
+            }
+        }
+    }
 
     /// The fixed-bandwidth factorisation and substitutions give the general ones' numbers
     /// bit for bit, with floored pivots, at sizes below, at and above twice the bandwidth.
@@ -360,6 +428,26 @@ mod tests {
                 assert_eq!(floored, floored_general, "{bw} {n}");
                 for (x, y) in a.band.iter().zip(&general.band) {
                     assert_eq!(x.to_bits(), y.to_bits(), "{bw} {n}");
+                }
+                if n >= 5 {
+                    // The plain factorisation (no floored pivot: a positive definite matrix).
+                    let mut spd = SymBanded::zeros(n, bw);
+                    for i in 0..n {
+                        for j in i.saturating_sub(bw)..=i {
+                            let v = if i == j {
+                                3.0 + (i as f64).sin()
+                            } else {
+                                0.1 * ((i * 7 + j * 3) as f64).cos()
+                            };
+                            spd.add(i, j, v);
+                        }
+                    }
+                    let mut general = spd.clone();
+                    general.bw_general_factorize();
+                    spd.factorize().unwrap();
+                    for (x, y) in spd.band.iter().zip(&general.band) {
+                        assert_eq!(x.to_bits(), y.to_bits(), "plain {bw} {n}");
+                    }
                 }
                 let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 1.3).sin()).collect();
                 let mut want = rhs.clone();

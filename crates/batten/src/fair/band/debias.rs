@@ -214,7 +214,7 @@ impl<'a, const D: usize> Penalized<'a, D> {
     /// (`weight(i)` gives `μ_i` of point `i`; `uniform` when every point has the same one).
     pub(super) fn minimiser(
         &self,
-        weight: impl Fn(usize) -> f64,
+        weight: impl Fn(usize) -> f64 + Sync,
         uniform: bool,
     ) -> Result<Vec<f64>> {
         let held = self.held;

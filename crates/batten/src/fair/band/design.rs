@@ -6,7 +6,7 @@
 //! four consecutive control points, so every matrix the solver builds keeps the band of the
 //! energy (half-bandwidth `4D − 1` in the interleaved numbering).
 
-use crate::numeric::SymBanded;
+use crate::numeric::{PARALLEL_FROM, SymBanded};
 use rayon::prelude::*;
 
 /// Points a task of [`Design::eval`] evaluates.
@@ -33,6 +33,25 @@ pub(super) struct SplineMap {
 }
 
 impl SplineMap {
+    /// Cuts of the points into pieces of about `size`, each cut where a knot span begins
+    /// (`first` changes), from 0 to the number of points.
+    fn span_cuts(&self, size: usize) -> Vec<usize> {
+        let n = self.first.len();
+        let mut cuts = vec![0];
+        let mut at = size;
+        while at < n {
+            while at < n && self.first[at] == self.first[at - 1] {
+                at += 1;
+            }
+            if at < n {
+                cuts.push(at);
+            }
+            at += size;
+        }
+        cuts.push(n);
+        cuts
+    }
+
     /// Call `add(row, col, value)` for the entries with `row ≥ col` of the 4×4 block `acc`
     /// (every coordinate) of the span whose first control point is `f`.
     fn add_span_lower<const D: usize>(
@@ -305,7 +324,7 @@ impl Design {
     /// [`Design::for_each_block_lower`] when each is `w_i I`, at a quarter of the work in 2-D.
     pub(super) fn for_each_weight_lower<const D: usize>(
         &self,
-        weight: impl Fn(usize) -> f64,
+        weight: impl Fn(usize) -> f64 + Sync,
         skip: &[bool],
         mut add: impl FnMut(usize, usize, f64),
     ) {
@@ -319,32 +338,46 @@ impl Design {
                 }
             }
             Design::Spline(s) => {
-                let mut acc = [[0.0; 4]; 4];
-                let mut current = None;
-                let mut flush = |f: usize, acc: &mut [[f64; 4]; 4]| {
-                    s.add_span_lower::<D>(f, acc, &mut add);
-                    *acc = [[0.0; 4]; 4];
+                // Each knot span's sum over its points, in point order, in pieces that start
+                // where a span does (in parallel on long curves), then reported span by span
+                // in order: the same sums and the same calls as one sweep.
+                let piece = |from: usize, to: usize| -> Vec<(usize, [[f64; 4]; 4])> {
+                    let mut out: Vec<(usize, [[f64; 4]; 4])> = Vec::new();
+                    for i in from..to {
+                        if skip[i] {
+                            continue;
+                        }
+                        let (f, b) = (s.first[i], &s.basis[i]);
+                        if out.last().is_none_or(|(g, _)| *g != f) {
+                            out.push((f, [[0.0; 4]; 4]));
+                        }
+                        let Some((_, acc)) = out.last_mut() else {
+                            continue;
+                        };
+                        let w = weight(i);
+                        for k in 0..4 {
+                            let wb = w * b[k];
+                            for l in 0..4 {
+                                acc[k][l] += wb * b[l];
+                            }
+                        }
+                    }
+                    out
                 };
-                for (i, (&f, b)) in s.first.iter().zip(&s.basis).enumerate() {
-                    if skip[i] {
-                        continue;
-                    }
-                    if current != Some(f) {
-                        if let Some(g) = current {
-                            flush(g, &mut acc);
-                        }
-                        current = Some(f);
-                    }
-                    let w = weight(i);
-                    for k in 0..4 {
-                        let wb = w * b[k];
-                        for l in 0..4 {
-                            acc[k][l] += wb * b[l];
-                        }
-                    }
-                }
-                if let Some(g) = current {
-                    flush(g, &mut acc);
+                let n = s.first.len();
+                let runs: Vec<(usize, [[f64; 4]; 4])> = if n >= PARALLEL_FROM {
+                    let cuts = s.span_cuts(EVAL_CHUNK);
+                    cuts.par_windows(2)
+                        .map(|c| piece(c[0], c[1]))
+                        .collect::<Vec<_>>()
+                        .into_iter()
+                        .flatten()
+                        .collect()
+                } else {
+                    piece(0, n)
+                };
+                for (f, acc) in &runs {
+                    s.add_span_lower::<D>(*f, acc, &mut add);
                 }
             }
         }
@@ -433,6 +466,65 @@ pub(super) mod tests {
                     assert_eq!(got.get(r, c).to_bits(), want.get(r, c).to_bits(), "{r} {c}");
                 }
             }
+        }
+    }
+
+    /// On a long curve (pieces in parallel) the weighted Gram matrix is reported in the
+    /// calls one sweep makes, with the same sums bit for bit.
+    #[test]
+    fn weight_gram_in_pieces_matches_one_sweep() {
+        let n = PARALLEL_FROM + 5000;
+        let spans = 3000;
+        let vars = spans + 3;
+        // Uneven runs: span k holds about n/spans points, more near the middle.
+        let first: Vec<usize> = (0..n)
+            .map(|i| {
+                let u = i as f64 / n as f64;
+                let v = u + 0.1 * (std::f64::consts::TAU * u).sin() / std::f64::consts::TAU;
+                ((v * spans as f64) as usize).min(spans - 1)
+            })
+            .collect();
+        let basis: Vec<[f64; 4]> = (0..n)
+            .map(|i| {
+                let u = (i as f64 * 0.37).fract();
+                [(1.0 - u) / 3.0, 0.4, u / 3.0, 0.1 + 0.01 * u]
+            })
+            .collect();
+        let map = SplineMap { vars, first, basis };
+        let skip: Vec<bool> = (0..n).map(|i| i % 11 == 5).collect();
+        let weight = |i: usize| 1.0 + (i as f64 * 0.01).sin().abs();
+        let mut want = Vec::new();
+        let mut acc = [[0.0; 4]; 4];
+        let mut current = None;
+        for i in 0..n {
+            if skip[i] {
+                continue;
+            }
+            let f = map.first[i];
+            if current != Some(f) {
+                if let Some(g) = current {
+                    map.add_span_lower::<2>(g, &acc, &mut |r, c, v| want.push((r, c, v)));
+                }
+                acc = [[0.0; 4]; 4];
+                current = Some(f);
+            }
+            for k in 0..4 {
+                let wb = weight(i) * map.basis[i][k];
+                for l in 0..4 {
+                    acc[k][l] += wb * map.basis[i][l];
+                }
+            }
+        }
+        if let Some(g) = current {
+            map.add_span_lower::<2>(g, &acc, &mut |r, c, v| want.push((r, c, v)));
+        }
+        let mut got = Vec::new();
+        Design::Spline(map).for_each_weight_lower::<2>(weight, &skip, |r, c, v| {
+            got.push((r, c, v));
+        });
+        assert_eq!(got.len(), want.len());
+        for (g, w) in got.iter().zip(&want) {
+            assert_eq!((g.0, g.1, g.2.to_bits()), (w.0, w.1, w.2.to_bits()));
         }
     }
 
