@@ -221,7 +221,8 @@ pub trait FairMethod: Sync {
     /// per-move part of the clean-curve guard, [`FairOptions::keep_clean`], which applies only
     /// to an input without inflections or vibrations): the common path then measures the
     /// input before the method runs. `true` (the default); methods without such a check
-    /// return `false`, and the input is measured while they run.
+    /// return `false`, and a long input (from `MEASURE_BESIDE_FROM` = 16 384 points) is
+    /// measured while they run.
     fn checks_moves(&self) -> bool {
         true
     }
@@ -386,7 +387,7 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
     check_options(m, input.is_closed(), options)?;
     let unit_scale = crate::geom::unit_scale(input.points());
     let measure = || FairnessMetrics::of_seq(&in_unit(input, unit_scale));
-    let (before, ran) = if m.checks_moves() {
+    let (before, ran) = if m.checks_moves() || input.len() < MEASURE_BESIDE_FROM {
         let before = measure()?;
         let ran = run_method(m, input, options, Some(&before));
         (before, ran)
@@ -413,6 +414,11 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
         (source, Some(sigma)),
     )
 }
+
+/// From this many points the input is measured beside the method's run (methods without a
+/// per-move check): below it the two are short, and many small curves already keep every core
+/// busy (`fair_many`).
+const MEASURE_BESIDE_FROM: usize = 1 << 14;
 
 /// What a method's run did (`run_method` here and in `space.rs`): the method's outcome,
 /// the options with the tolerance it used, when it started (the noise estimate counts),

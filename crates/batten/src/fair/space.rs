@@ -135,11 +135,13 @@ pub fn fair_space(name: &str, input: &SpaceSeq, options: &FairOptions) -> Result
     super::check_options(m, input.is_closed(), options)?;
     let unit_scale = unit_scale_xyz(input.points());
     // The input's measures and the method are independent (no space method checks single
-    // moves): the measures take the core a method's serial solve leaves idle.
-    let (before, ran) = rayon::join(
-        || SpaceMetrics::of_seq(&scaled_seq(input, 1.0 / unit_scale)?),
-        || run_method(m, input, options, unit_scale),
-    );
+    // moves): on long curves the measures take the core a method's serial solve leaves idle.
+    let measure = || SpaceMetrics::of_seq(&scaled_seq(input, 1.0 / unit_scale)?);
+    let (before, ran) = if input.len() < super::MEASURE_BESIDE_FROM {
+        (measure(), run_method(m, input, options, unit_scale))
+    } else {
+        rayon::join(measure, || run_method(m, input, options, unit_scale))
+    };
     let before = before?;
     let Ran {
         outcome,

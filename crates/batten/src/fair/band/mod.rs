@@ -112,7 +112,7 @@ pub fn auto_k(n: usize) -> f64 {
 pub struct Band;
 
 impl FairMethod for Band {
-    /// No per-move check: the input is measured while the method runs.
+    /// No per-move check: a long input is measured while the method runs.
     fn checks_moves(&self) -> bool {
         false
     }

@@ -191,7 +191,7 @@ fn cali_params(options: &FairOptions) -> Result<(f64, f64, usize)> {
 }
 
 impl FairMethod for Cali {
-    /// No per-move check: the input is measured while the method runs.
+    /// No per-move check: a long input is measured while the method runs.
     fn checks_moves(&self) -> bool {
         false
     }

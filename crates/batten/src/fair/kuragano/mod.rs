@@ -70,7 +70,7 @@ use run::run_points;
 pub struct Kuragano;
 
 impl FairMethod for Kuragano {
-    /// No per-move check: the input is measured while the method runs.
+    /// No per-move check: a long input is measured while the method runs.
     fn checks_moves(&self) -> bool {
         false
     }

@@ -112,7 +112,7 @@ pub use target::{MAX_SAMPLES, Smoother};
 pub struct Salvi;
 
 impl FairMethod for Salvi {
-    /// No per-move check: the input is measured while the method runs.
+    /// No per-move check: a long input is measured while the method runs.
     fn checks_moves(&self) -> bool {
         false
     }

@@ -54,7 +54,7 @@ pub(super) fn p_at_scale(p: f64, f: f64) -> f64 {
 }
 
 impl FairMethod for Mst {
-    /// No per-move check: the input is measured while the method runs.
+    /// No per-move check: a long input is measured while the method runs.
     fn checks_moves(&self) -> bool {
         false
     }
