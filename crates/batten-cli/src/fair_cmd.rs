@@ -7,7 +7,7 @@ use anyhow::anyhow;
 use batten::fair::{self, FairMethod, FairReport, FairStatus};
 use batten::io::{self, Format, IoError, PointData, format_f64};
 use batten::spline::BSplineCurve;
-use batten::{FairOptions, Faired, PointSeq, Vec2, analysis};
+use batten::{FairOptions, Faired, Point, PointSeq, Vec2, analysis};
 
 use crate::FairArgs;
 use crate::failure::{EXIT_FAILED, Failure};
@@ -65,9 +65,29 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
     let failed =
         |e| Failure::from_batten(&format!("{input_name}: method {} failed", method.name()), e);
     spinner.set_message(format!("fairing with {}", method.name()));
-    let faired = match &source {
-        Source::Curve(curve) => fair::fair_curve(method.name(), curve, &options).map_err(failed)?,
-        Source::Points(d) => fair::fair_with(method, &d.seq, &options).map_err(failed)?,
+    let out_name = formats::display_name(&args.output);
+    // Faired points for a file are written into its temporary file while the result is
+    // measured (`io::stage`); kept only when the clean-curve guard kept them. A staging that
+    // fails is dropped: the points are then written with the rest, which reports the error.
+    let (faired, staged) = match &source {
+        Source::Curve(curve) => (
+            fair::fair_curve(method.name(), curve, &options).map_err(failed)?,
+            None,
+        ),
+        Source::Points(d) => {
+            let stage = |pre: fair::Provisional<'_>| -> Option<io::Staged> {
+                if to_stdout {
+                    return None;
+                }
+                let tangents = pre.tangents.or(d.tangents.as_deref());
+                let pts = (pre.points, pre.curve, d.seq.is_closed(), tangents);
+                let bytes = points_bytes(out_format, &out_name, pts, &origin).ok()?;
+                io::stage(&args.output, &bytes).ok()
+            };
+            let (faired, staged, kept) =
+                fair::fair_with_beside(method, &d.seq, &options, stage).map_err(failed)?;
+            (faired, staged.filter(|_| kept))
+        }
     };
     let data = match &source {
         Source::Points(d) => Some(d),
@@ -80,8 +100,10 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         .tangents
         .as_deref()
         .or(data.and_then(|d| d.tangents.as_deref()));
-    let out_name = formats::display_name(&args.output);
-    let bytes = output_bytes(out_format, &out_name, &faired, closed, tangents, &origin)?;
+    let bytes = match staged {
+        Some(_) => Vec::new(),
+        None => output_bytes(out_format, &out_name, &faired, closed, tangents, &origin)?,
+    };
     // One set, all or none: the report and the curve first, the points last, so that a
     // faired file beside an older report cannot happen (see `io::write_atomic_set`). Points
     // for standard output go there once the files are written.
@@ -99,7 +121,7 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
         args,
         report.as_ref().map(|(_, b)| b.as_slice()),
         curve.as_ref().map(|(p, b)| (p.as_path(), b.as_slice())),
-        &bytes,
+        (&bytes, staged),
         spinner,
     )?;
     let figures = figures(&faired.report);
@@ -187,12 +209,29 @@ fn output_bytes(
     tangents: Option<&[Vec2]>,
     origin: &io::Origin,
 ) -> Result<Vec<u8>, Failure> {
-    match (format, faired.curve.as_ref()) {
+    let pts = (
+        faired.points.as_slice(),
+        faired.curve.as_ref(),
+        closed,
+        tangents,
+    );
+    points_bytes(format, out_name, pts, origin)
+}
+
+/// The faired points (or the curve, where the format holds it), closed or not, with their
+/// tangents, as the bytes of `format`.
+fn points_bytes(
+    format: Format,
+    out_name: &Path,
+    (points, curve, closed, tangents): (&[Point], Option<&BSplineCurve>, bool, Option<&[Vec2]>),
+    origin: &io::Origin,
+) -> Result<Vec<u8>, Failure> {
+    match (format, curve) {
         // SVG holds the faired B-spline itself when it can (a method's cubic).
         (Format::Svg, Some(c)) if io::svg_can_hold(c) => {
             io::format_curve(format, out_name, c, closed, origin)
         }
-        _ => io::format_points(format, out_name, &faired.points, closed, tangents, origin),
+        _ => io::format_points(format, out_name, points, closed, tangents, origin),
     }
     .map_err(Failure::failed)
 }
@@ -206,7 +245,7 @@ pub fn write_outputs(
     args: &FairArgs,
     report: Option<&[u8]>,
     curve: Option<(&Path, &[u8])>,
-    bytes: &[u8],
+    (bytes, staged): (&[u8], Option<io::Staged>),
     spinner: Spinner,
 ) -> Result<(), Failure> {
     let to_stdout = formats::is_stdio(&args.output);
@@ -215,10 +254,17 @@ pub fn write_outputs(
         set.push((path.as_path(), b));
     }
     set.extend(curve);
-    if !to_stdout {
-        set.push((&args.output, bytes));
+    match staged {
+        // The points, written already, renamed last.
+        Some(staged) => io::write_atomic_set_staged(&set, staged),
+        None => {
+            if !to_stdout {
+                set.push((&args.output, bytes));
+            }
+            io::write_atomic_set(&set)
+        }
     }
-    io::write_atomic_set(&set).map_err(Failure::failed)?;
+    .map_err(Failure::failed)?;
     spinner.finish();
     if to_stdout {
         formats::write_output(&args.output, bytes)?;

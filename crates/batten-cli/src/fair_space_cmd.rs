@@ -65,7 +65,7 @@ pub fn run(
         Some(_) => Some(fair_cmd::report_json(&faired.report)?.into_bytes()),
         None => None,
     };
-    fair_cmd::write_outputs(args, report.as_deref(), None, &bytes, spinner)?;
+    fair_cmd::write_outputs(args, report.as_deref(), None, (&bytes, None), spinner)?;
     let r = &faired.report;
     let figures = SummaryFigures {
         method: &r.method,

@@ -806,3 +806,43 @@ fn fix_ends_levels() {
     );
     assert!(!out.exists());
 }
+
+/// The faired points are written into their temporary file while the result is measured;
+/// when the clean-curve guard then returns the input instead, that file is dropped: the
+/// output holds the input's points, and no temporary file is left beside it.
+#[test]
+fn points_written_ahead_are_dropped_when_the_guard_returns_the_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let input = common::example("arc-truth.csv");
+    let (out, rep) = (d.join("out.csv"), d.join("r.json"));
+    let o = batten(&[
+        "fair",
+        s(&input),
+        "--method",
+        "band",
+        "--tolerance",
+        "0.01",
+        "-o",
+        s(&out),
+        "--report",
+        s(&rep),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let report: Value = serde_json::from_str(&fs::read_to_string(&rep).unwrap()).unwrap();
+    assert_eq!(report["status"], "no_change", "{report}");
+    let numbers = |path: &Path| -> Vec<f64> {
+        fs::read_to_string(path)
+            .unwrap()
+            .lines()
+            .filter(|l| !l.starts_with('#') && !l.starts_with('x') && !l.trim().is_empty())
+            .flat_map(|l| {
+                l.split(',')
+                    .map(|v| v.trim().parse::<f64>().unwrap())
+                    .collect::<Vec<_>>()
+            })
+            .collect()
+    };
+    assert_eq!(numbers(&out), numbers(&input));
+    assert_eq!(common::names(d), vec!["out.csv", "r.json"]);
+}

@@ -384,6 +384,37 @@ pub fn fair(name: &str, input: &PointSeq, options: &FairOptions) -> Result<Faire
 /// # Errors
 /// As [`fair`].
 pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) -> Result<Faired> {
+    fair_with_beside(m, input, options, |_| ()).map(|(faired, (), _)| faired)
+}
+
+/// A method's result before it is measured and the clean-curve guard has seen it: what
+/// [`fair_with_beside`] shows its `beside` closure.
+#[derive(Clone, Copy, Debug)]
+#[non_exhaustive]
+pub struct Provisional<'a> {
+    /// The faired points.
+    pub points: &'a [Point],
+    /// The faired curve, where the method works on one.
+    pub curve: Option<&'a BSplineCurve>,
+    /// Updated tangents, where the method carries them.
+    pub tangents: Option<&'a [Vec2]>,
+}
+
+/// As [`fair_with`], with `beside` run on the method's result while the result is measured:
+/// for a caller that writes the result, so that the writing overlaps the measuring (on long
+/// curves; short ones run one after the other). The result `beside` saw is the final one
+/// unless the clean-curve guard returned the input instead; the flag says whether it is
+/// (`true`: the points, curve and tangents of the [`Faired`] are those `beside` saw).
+///
+/// # Errors
+/// As [`fair`]. `beside` has run by then (unless the method failed): what it made is
+/// dropped.
+pub fn fair_with_beside<T: Send>(
+    m: &dyn FairMethod,
+    input: &PointSeq,
+    options: &FairOptions,
+    beside: impl FnOnce(Provisional<'_>) -> T + Send,
+) -> Result<(Faired, T, bool)> {
     check_options(m, input.is_closed(), options)?;
     let unit_scale = crate::geom::unit_scale(input.points());
     let measure = || FairnessMetrics::of_seq(&in_unit(input, unit_scale));
@@ -412,6 +443,7 @@ pub fn fair_with(m: &dyn FairMethod, input: &PointSeq, options: &FairOptions) ->
         outcome,
         start,
         (source, Some(sigma)),
+        beside,
     )
 }
 
@@ -702,7 +734,9 @@ pub fn fair_curve(name: &str, curve: &BSplineCurve, options: &FairOptions) -> Re
         outcome,
         start,
         (source, None),
+        |_| (),
     )
+    .map(|(faired, (), _)| faired)
 }
 
 /// `seq` divided by `s` (exact: `s` is a power of two).
@@ -716,7 +750,8 @@ fn in_unit(seq: &PointSeq, s: f64) -> Cow<'_, PointSeq> {
 /// The common part of every report: the clean-curve guard, displacements, metrics after,
 /// the tolerance verdict. `before` is measured on the input divided by `unit_scale`, and
 /// `curve` is the input curve of [`fair_curve`].
-fn finish(
+#[allow(clippy::too_many_arguments)]
+fn finish<T: Send>(
     m: &dyn FairMethod,
     (input, curve): (&PointSeq, Option<&BSplineCurve>),
     (before, unit_scale): (FairnessMetrics, f64),
@@ -724,7 +759,8 @@ fn finish(
     mut outcome: Outcome,
     start: Instant,
     (tolerance_source, noise_sigma): (Option<ToleranceSource>, Option<f64>),
-) -> Result<Faired> {
+    beside: impl FnOnce(Provisional<'_>) -> T + Send,
+) -> Result<(Faired, T, bool)> {
     let elapsed = start.elapsed();
     if outcome.points.len() != input.len() {
         return Err(Error::LengthMismatch {
@@ -734,7 +770,19 @@ fn finish(
         });
     }
     let mut faired = input.with_points(outcome.points.clone())?;
-    let mut after = FairnessMetrics::of_seq(&in_unit(&faired, unit_scale))?;
+    let measure = || FairnessMetrics::of_seq(&in_unit(&faired, unit_scale));
+    let provisional = Provisional {
+        points: &outcome.points,
+        curve: outcome.curve.as_ref(),
+        tangents: outcome.tangents.as_deref(),
+    };
+    let (after, side) = if input.len() < MEASURE_BESIDE_FROM {
+        (measure(), beside(provisional))
+    } else {
+        rayon::join(measure, || beside(provisional))
+    };
+    let mut after = after?;
+    let mut kept = true;
     if options.keep_clean
         && m.keeps_clean()
         && let Some(why) = guard::worse(&before, &after)
@@ -755,6 +803,7 @@ fn finish(
         };
         faired = input.clone();
         after = before.clone();
+        kept = false;
     }
     let (before, after) = (before.rescaled(unit_scale), after.rescaled(unit_scale));
     let end_changes = end_changes(input, &faired);
@@ -797,12 +846,13 @@ fn finish(
         solver: outcome.solver,
         notes,
     };
-    Ok(Faired {
+    let faired = Faired {
         points: outcome.points,
         report,
         curve: outcome.curve,
         tangents: outcome.tangents,
-    })
+    };
+    Ok((faired, side, kept))
 }
 
 /// The tolerance verdict every report shares: whether the largest displacement `max` is

@@ -175,10 +175,64 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), IoError> {
 /// # Errors
 /// [`IoError::Write`] naming the file that could not be written.
 pub fn write_atomic_set(files: &[(&Path, &[u8])]) -> Result<(), IoError> {
-    let mut temps: Vec<PathBuf> = Vec::with_capacity(files.len());
+    write_set(files, None)
+}
+
+/// A file written into its temporary file ahead of the set it belongs to ([`stage`]):
+/// flushed to disk and registered like every temporary file, not yet renamed. Given to
+/// [`write_atomic_set_staged`] it is renamed last; dropped otherwise, its temporary file is
+/// removed.
+#[derive(Debug)]
+pub struct Staged {
+    path: PathBuf,
+    tmp: Option<PathBuf>,
+}
+
+impl Drop for Staged {
+    fn drop(&mut self) {
+        if let Some(tmp) = self.tmp.take() {
+            discard(&tmp);
+        }
+    }
+}
+
+/// Write `contents` into a new temporary file beside `path` and flush it, ahead of the set
+/// it will belong to ([`write_atomic_set_staged`]): so that a caller can write a large file
+/// while it still computes the others. `path` itself is not touched.
+///
+/// # Errors
+/// [`IoError::Write`]; the temporary file is then removed.
+pub fn stage(path: &Path, contents: &[u8]) -> Result<Staged, IoError> {
+    let (tmp, mut file) = create_temporary(path)?;
+    let staged = Staged {
+        path: path.to_path_buf(),
+        tmp: Some(tmp),
+    };
+    file.write_all(contents)
+        .and_then(|()| file.sync_all())
+        .map_err(|source| IoError::Write {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    Ok(staged)
+}
+
+/// As [`write_atomic_set`], with `staged` (written ahead by [`stage`]) the set's last file:
+/// `files` are written, then renamed in order, then `staged`. A failure while writing
+/// removes `staged`'s temporary file too.
+///
+/// # Errors
+/// As [`write_atomic_set`].
+pub fn write_atomic_set_staged(files: &[(&Path, &[u8])], staged: Staged) -> Result<(), IoError> {
+    write_set(files, Some(staged))
+}
+
+/// [`write_atomic_set`], and [`write_atomic_set_staged`] with `staged`.
+fn write_set(files: &[(&Path, &[u8])], mut staged: Option<Staged>) -> Result<(), IoError> {
+    let mut temps: Vec<(PathBuf, PathBuf)> = Vec::with_capacity(files.len() + 1);
     let written = files.iter().try_for_each(|&(path, contents)| {
         let (tmp, mut file) = create_temporary(path)?;
-        temps.push(tmp);
+        temps.push((tmp, path.to_path_buf()));
         file.write_all(contents)
             .and_then(|()| file.sync_all())
             .map_err(|source| IoError::Write {
@@ -187,16 +241,22 @@ pub fn write_atomic_set(files: &[(&Path, &[u8])]) -> Result<(), IoError> {
             })
     });
     if let Err(e) = written {
-        temps.iter().for_each(|t| discard(t));
+        temps.iter().for_each(|(t, _)| discard(t));
+        // `staged`, dropped, removes its own.
         return Err(e);
+    }
+    if let Some(s) = staged.as_mut()
+        && let Some(tmp) = s.tmp.take()
+    {
+        temps.push((tmp, s.path.clone()));
     }
     // The renames hold the registry, so that a cleanup on a signal waits for the whole set.
     let mut r = registry();
     let mut result = Ok(());
-    for (tmp, &(path, _)) in temps.iter().zip(files) {
+    for (tmp, path) in &temps {
         if result.is_ok() {
             result = fs::rename(tmp, path).map_err(|source| IoError::Write {
-                path: path.to_path_buf(),
+                path: path.clone(),
                 source,
             });
         }
@@ -264,5 +324,31 @@ mod tests {
         assert!(check_writable(Path::new("/proc/x.json")).is_err());
         assert_eq!(names(&dir), ["d.json"]);
         fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A staged file is renamed last in its set, after the files written with it; dropped
+    /// without a set, or with a set that fails, its temporary file goes.
+    #[test]
+    fn staged_files_are_renamed_last_or_removed() {
+        let d = tempdir();
+        let (report, points) = (d.join("r.json"), d.join("p.csv"));
+        let staged = stage(&points, b"1,2\n").unwrap();
+        assert_eq!(names(&d).len(), 1, "{:?}", names(&d));
+        assert!(!points.exists());
+        write_atomic_set_staged(&[(&report, b"{}")], staged).unwrap();
+        assert_eq!(names(&d), vec!["p.csv", "r.json"]);
+        assert_eq!(fs::read(&points).unwrap(), b"1,2\n");
+        // Dropped: removed.
+        let staged = stage(&points, b"3,4\n").unwrap();
+        drop(staged);
+        assert_eq!(names(&d), vec!["p.csv", "r.json"]);
+        assert_eq!(fs::read(&points).unwrap(), b"1,2\n");
+        // A set that fails (a file in a missing directory): nothing renamed, nothing left.
+        let staged = stage(&points, b"5,6\n").unwrap();
+        let bad = d.join("missing").join("r.json");
+        assert!(write_atomic_set_staged(&[(&bad, b"{}")], staged).is_err());
+        assert_eq!(names(&d), vec!["p.csv", "r.json"]);
+        assert_eq!(fs::read(&points).unwrap(), b"1,2\n");
+        fs::remove_dir_all(&d).unwrap();
     }
 }

@@ -86,7 +86,10 @@ mod text;
 
 use std::path::Path;
 
-pub use atomic::{check_writable, remove_temporaries, write_atomic, write_atomic_set};
+pub use atomic::{
+    Staged, check_writable, remove_temporaries, stage, write_atomic, write_atomic_set,
+    write_atomic_set_staged,
+};
 pub use dxf::{DxfCurve, DxfDrawing, DxfGeometry};
 pub use error::{IoError, Location};
 pub use input::{Input, Origin, Pick, Source, parse_input, read_input};
