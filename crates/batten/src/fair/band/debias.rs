@@ -330,10 +330,14 @@ impl<'a, const D: usize> Penalized<'a, D> {
     /// The residual `B y − c` of every point (zero at pinned points).
     pub(super) fn residual(&self, y: &[f64]) -> Vec<f64> {
         let mut r = vec![0.0; self.points() * D];
-        self.design.eval::<D>(y, &mut r);
-        for (k, (rk, c)) in r.iter_mut().zip(self.centres).enumerate() {
-            *rk = if self.pinned[k / D] { 0.0 } else { *rk - c };
-        }
+        let (pinned, centres) = (self.pinned, self.centres);
+        self.design.eval_then::<D>(y, &mut r, |i, q| {
+            if pinned[i] {
+                [0.0; D]
+            } else {
+                std::array::from_fn(|a| q[a] - centres[i * D + a])
+            }
+        });
         r
     }
 

@@ -181,8 +181,23 @@ impl Design {
 
     /// `out = B x` (flat, `D` numbers a point).
     pub(super) fn eval<const D: usize>(&self, x: &[f64], out: &mut [f64]) {
+        self.eval_then::<D>(x, out, |_, q| q);
+    }
+
+    /// `out_i = then(i, (B x)_i)` for every point `i` (flat, `D` numbers a point): what a
+    /// sweep does with each point's value, in the same parallel pieces as the evaluation.
+    pub(super) fn eval_then<const D: usize>(
+        &self,
+        x: &[f64],
+        out: &mut [f64],
+        then: impl Fn(usize, [f64; D]) -> [f64; D] + Sync,
+    ) {
         match self {
-            Design::Points { .. } => out.copy_from_slice(x),
+            Design::Points { .. } => {
+                for (i, (o, v)) in out.chunks_exact_mut(D).zip(x.chunks_exact(D)).enumerate() {
+                    o.copy_from_slice(&then(i, std::array::from_fn(|a| v[a])));
+                }
+            }
             Design::Spline(s) => {
                 // Every point on its own: in chunks on the pool's threads (the same sums
                 // whatever the split).
@@ -190,9 +205,10 @@ impl Design {
                     .enumerate()
                     .for_each(|(c, out)| {
                         let from = c * EVAL_CHUNK;
-                        for (o, (&f, b)) in out
+                        for (k, (o, (&f, b))) in out
                             .chunks_exact_mut(D)
                             .zip(s.first[from..].iter().zip(&s.basis[from..]))
+                            .enumerate()
                         {
                             let mut q = [0.0; D];
                             if f + 4 <= s.vars {
@@ -210,7 +226,7 @@ impl Design {
                                     }
                                 }
                             }
-                            o.copy_from_slice(&q);
+                            o.copy_from_slice(&then(from + k, q));
                         }
                     });
             }

@@ -502,10 +502,9 @@ fn band_problem<'a, const D: usize>(
     let mut anchor = vec![0.0; reference.len()];
     energy.apply_add(reference, &mut anchor);
     let mut centres = vec![0.0; scaled.len()];
-    form.design.eval::<D>(reference, &mut centres);
-    for (c, a) in centres.iter_mut().zip(scaled) {
-        *c = a - *c;
-    }
+    form.design.eval_then::<D>(reference, &mut centres, |i, q| {
+        std::array::from_fn(|a| scaled[i * D + a] - q[a])
+    });
     Problem {
         energy,
         anchor,

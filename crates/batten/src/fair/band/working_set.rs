@@ -60,10 +60,9 @@ pub(super) fn solve<const D: usize>(
     let mut iterations = 0;
     let mut r = vec![0.0; n * D];
     let mut r0 = vec![0.0; n * D];
-    p.design.eval::<D>(start, &mut r0);
-    for (v, c) in r0.iter_mut().zip(&p.centres) {
-        *v -= c;
-    }
+    p.design.eval_then::<D>(start, &mut r0, |i, q| {
+        std::array::from_fn(|a| q[a] - p.centres[i * D + a])
+    });
     for _ in 0..MAX_ROUNDS {
         let set: Vec<usize> = (0..n).filter(|&i| in_set[i]).collect();
         let design = Design::Spline(SplineMap {
@@ -90,10 +89,13 @@ pub(super) fn solve<const D: usize>(
         };
         let sol = solve_all(&sub)?;
         iterations += sol.iterations;
-        p.design.eval::<D>(&sol.y, &mut r);
-        for (k, (v, c)) in r.iter_mut().zip(&p.centres).enumerate() {
-            *v = if p.pinned[k / D] { 0.0 } else { *v - c };
-        }
+        p.design.eval_then::<D>(&sol.y, &mut r, |i, q| {
+            if p.pinned[i] {
+                [0.0; D]
+            } else {
+                std::array::from_fn(|a| q[a] - p.centres[i * D + a])
+            }
+        });
         let outside =
             (0..n).any(|i| !in_set[i] && !p.pinned[i] && norm2(&r[i * D..(i + 1) * D]) > 1.0);
         if !outside {
