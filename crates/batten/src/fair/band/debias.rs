@@ -178,10 +178,13 @@ impl<'a, const D: usize> Penalized<'a, D> {
         // The data term's pull on the free unknowns: towards the centres less what the held
         // unknowns already give the points (in the point form they give only their own).
         let mut shifted = vec![0.0; design.points() * D];
-        design.eval::<D>(&fixed, &mut shifted);
-        for (k, (s, c)) in shifted.iter_mut().zip(centres).enumerate() {
-            *s = if pinned[k / D] { 0.0 } else { c - *s };
-        }
+        design.eval_then::<D>(&fixed, &mut shifted, |i, q| {
+            if pinned[i] {
+                [0.0; D]
+            } else {
+                std::array::from_fn(|a| centres[i * D + a] - q[a])
+            }
+        });
         let mut pull = vec![0.0; dim];
         let doubled: Vec<f64> = shifted.iter().map(|s| 2.0 * s).collect();
         design.eval_t_add::<D>(&doubled, &mut pull);
