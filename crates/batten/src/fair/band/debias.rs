@@ -344,6 +344,24 @@ impl<'a, const D: usize> Penalized<'a, D> {
         r
     }
 
+    /// The length `|(B y)_i − c_i|` of every point's residual (zero at pinned points), as
+    /// [`Penalized::residual`] gives it, without the residual vectors.
+    pub(super) fn residual_lengths(&self, y: &[f64]) -> Vec<f64> {
+        let (pinned, centres) = (self.pinned, self.centres);
+        self.design.map_points::<D, f64>(y, |i, q| {
+            if pinned[i] {
+                return 0.0;
+            }
+            (0..D)
+                .map(|a| {
+                    let r = q[a] - centres[i * D + a];
+                    r * r
+                })
+                .sum::<f64>()
+                .sqrt()
+        })
+    }
+
     /// The mean squared residual `(1/free) Σ |(B y)_i − c_i|²` over the free points.
     fn mean_square_residual(&self, y: &[f64]) -> f64 {
         let free = self.pinned.iter().filter(|h| !**h).count().max(1);

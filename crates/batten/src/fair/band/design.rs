@@ -6,7 +6,7 @@
 //! four consecutive control points, so every matrix the solver builds keeps the band of the
 //! energy (half-bandwidth `4D − 1` in the interleaved numbering).
 
-use crate::numeric::{PARALLEL_FROM, SymBanded};
+use crate::numeric::{PARALLEL_FROM, SymBanded, map_indices};
 use rayon::prelude::*;
 
 /// Points a task of [`Design::eval`] evaluates.
@@ -33,6 +33,33 @@ pub(super) struct SplineMap {
 }
 
 impl SplineMap {
+    /// Point `i` of the spline with control points `x` (flat, `D` numbers each).
+    fn point<const D: usize>(&self, i: usize, x: &[f64]) -> [f64; D] {
+        self.point_at::<D>(self.first[i], &self.basis[i], x)
+    }
+
+    /// `Σ_k b_k x_{f+k}` (indices wrapped for closed curves).
+    #[inline]
+    fn point_at<const D: usize>(&self, f: usize, b: &[f64; 4], x: &[f64]) -> [f64; D] {
+        let mut q = [0.0; D];
+        if f + 4 <= self.vars {
+            let x = &x[f * D..(f + 4) * D];
+            for (k, bk) in b.iter().enumerate() {
+                for a in 0..D {
+                    q[a] += bk * x[k * D + a];
+                }
+            }
+        } else {
+            for (k, bk) in b.iter().enumerate() {
+                let j = (f + k) % self.vars;
+                for a in 0..D {
+                    q[a] += bk * x[j * D + a];
+                }
+            }
+        }
+        q
+    }
+
     /// Cuts of the points into pieces of about `size`, each cut where a knot span begins
     /// (`first` changes), from 0 to the number of points.
     fn span_cuts(&self, size: usize) -> Vec<usize> {
@@ -184,6 +211,20 @@ impl Design {
         self.eval_then::<D>(x, out, |_, q| q);
     }
 
+    /// `f(i, (B x)_i)` for every point `i`, in order, evaluated in parallel pieces.
+    pub(super) fn map_points<const D: usize, T: Send>(
+        &self,
+        x: &[f64],
+        f: impl Fn(usize, [f64; D]) -> T + Sync + Send,
+    ) -> Vec<T> {
+        match self {
+            Design::Points { n } => (0..*n)
+                .map(|i| f(i, std::array::from_fn(|a| x[i * D + a])))
+                .collect(),
+            Design::Spline(s) => map_indices(s.first.len(), |i| f(i, s.point::<D>(i, x))),
+        }
+    }
+
     /// `out_i = then(i, (B x)_i)` for every point `i` (flat, `D` numbers a point): what a
     /// sweep does with each point's value, in the same parallel pieces as the evaluation.
     pub(super) fn eval_then<const D: usize>(
@@ -210,23 +251,7 @@ impl Design {
                             .zip(s.first[from..].iter().zip(&s.basis[from..]))
                             .enumerate()
                         {
-                            let mut q = [0.0; D];
-                            if f + 4 <= s.vars {
-                                let x = &x[f * D..(f + 4) * D];
-                                for (k, bk) in b.iter().enumerate() {
-                                    for a in 0..D {
-                                        q[a] += bk * x[k * D + a];
-                                    }
-                                }
-                            } else {
-                                for (k, bk) in b.iter().enumerate() {
-                                    let j = (f + k) % s.vars;
-                                    for a in 0..D {
-                                        q[a] += bk * x[j * D + a];
-                                    }
-                                }
-                            }
-                            o.copy_from_slice(&then(from + k, q));
+                            o.copy_from_slice(&then(from + k, s.point_at::<D>(f, b, x)));
                         }
                     });
             }

@@ -213,13 +213,7 @@ pub(super) fn feasible_fit<const D: usize>(
         let Ok(x) = fit.minimiser_raised(mu, &weights, &raised) else {
             break;
         };
-        let r = fit.residual(&x);
-        let lengths = map_indices(weights.len(), |i| {
-            (0..D)
-                .map(|a| r[i * D + a] * r[i * D + a])
-                .sum::<f64>()
-                .sqrt()
-        });
+        let lengths = fit.residual_lengths(&x);
         let mut farthest = 0.0_f64;
         for (w, (i, &len)) in weights.iter_mut().zip(lengths.iter().enumerate()) {
             farthest = farthest.max(len);
