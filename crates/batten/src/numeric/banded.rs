@@ -187,16 +187,7 @@ impl SymBanded {
             for (kk, v) in scaled.iter().enumerate() {
                 d -= v * win[row + (BW - kk)];
             }
-            if !d.is_finite() {
-                return Err(Error::Singular(format!(
-                    "band matrix has a non-finite pivot ({i})"
-                )));
-            }
-            if d < delta {
-                d = delta;
-                regularized += 1;
-            }
-            win[row] = d;
+            win[row] = floored_pivot(d, delta, i, &mut regularized)?;
         }
         self.factored = true;
         Ok(regularized)
@@ -225,16 +216,7 @@ impl SymBanded {
             for (k, v) in scaled[..m].iter().enumerate() {
                 d -= v * self.band[i * w + (i - (lo + k))];
             }
-            if !d.is_finite() {
-                return Err(Error::Singular(format!(
-                    "band matrix has a non-finite pivot ({i})"
-                )));
-            }
-            if d < delta {
-                d = delta;
-                regularized += 1;
-            }
-            self.band[i * w] = d;
+            self.band[i * w] = floored_pivot(d, delta, i, &mut regularized)?;
         }
         self.factored = true;
         Ok(regularized)
@@ -355,6 +337,21 @@ impl SymBanded {
             head[i] = s;
         }
     }
+}
+
+/// A pivot of [`SymBanded::factorize_regularized`]: `d`, or `delta` when `d` is below it
+/// (counted in `regularized`); the error when it is not finite.
+fn floored_pivot(d: f64, delta: f64, i: usize, regularized: &mut usize) -> Result<f64> {
+    if !d.is_finite() {
+        return Err(Error::Singular(format!(
+            "band matrix has a non-finite pivot ({i})"
+        )));
+    }
+    if d < delta {
+        *regularized += 1;
+        return Ok(delta);
+    }
+    Ok(d)
 }
 
 /// A pivot of [`SymBanded::factorize`], or the error when it is (relatively) zero,
