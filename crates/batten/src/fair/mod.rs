@@ -418,14 +418,14 @@ pub fn fair_with_beside<T: Send>(
     check_options(m, input.is_closed(), options)?;
     let unit_scale = crate::geom::unit_scale(input.points());
     let measure = || FairnessMetrics::of_seq(&in_unit(input, unit_scale));
-    let (before, ran) = if m.checks_moves() || input.len() < MEASURE_BESIDE_FROM {
+    let (before, ran) = if m.checks_moves() {
         let before = measure()?;
         let ran = run_method(m, input, options, Some(&before));
         (before, ran)
     } else {
-        // The input's measures and the method are independent: the measures' parallel
-        // pieces take the core a method's serial solve leaves idle.
-        let (before, ran) = rayon::join(measure, || run_method(m, input, options, None));
+        // The input's measures and the method are independent.
+        let (before, ran) =
+            beside_if_long(input.len(), measure, || run_method(m, input, options, None));
         (before?, ran)
     };
     let Ran {
@@ -447,10 +447,25 @@ pub fn fair_with_beside<T: Send>(
     )
 }
 
-/// From this many points the input is measured beside the method's run (methods without a
-/// per-move check): below it the two are short, and many small curves already keep every core
-/// busy (`fair_many`).
+/// From this many points the measures run beside the method and the writing
+/// ([`beside_if_long`]): below it the two are short, and many small curves already keep every
+/// core busy (`fair_many`).
 const MEASURE_BESIDE_FROM: usize = 1 << 14;
+
+/// `a()` and `b()`: side by side (`rayon::join`) for a curve of `n` points from
+/// [`MEASURE_BESIDE_FROM`] on, where a measure's parallel pieces take the core a method's
+/// serial solve or a write leaves idle; one after the other below.
+fn beside_if_long<A: Send, B: Send>(
+    n: usize,
+    a: impl FnOnce() -> A + Send,
+    b: impl FnOnce() -> B + Send,
+) -> (A, B) {
+    if n < MEASURE_BESIDE_FROM {
+        (a(), b())
+    } else {
+        rayon::join(a, b)
+    }
+}
 
 /// What a method's run did (`run_method` here and in `space.rs`): the method's outcome,
 /// the options with the tolerance it used, when it started (the noise estimate counts),
@@ -477,9 +492,8 @@ fn run_method(
     let xy: Vec<[f64; 2]> = input.points().iter().map(|p| [p.x, p.y]).collect();
     let noise = NoiseMeasure::of(&xy, input.is_closed());
     let sigma = noise.sigma(Spread::OneD);
-    let (resolved, source) =
+    let (mut resolved, source) =
         resolve_tolerance(m, options, sigma, input.bbox().diagonal(), input.len())?;
-    let mut resolved = resolved;
     let unchanged = left_as_is(&resolved, source, input.len(), input.is_closed(), || {
         noise.correlation()
     });
@@ -609,8 +623,8 @@ fn run_widening<O>(
 }
 
 /// Why the input comes back as it is without running the method, if it does: every point
-/// held ([`all_held`]), or an automatic tolerance that finds no noise ([`no_noise`]; `pts`
-/// gives the points, asked for only then).
+/// held ([`all_held`]), or an automatic tolerance that finds no noise ([`no_noise`];
+/// `correlation` gives the noise differences' correlation, asked for only then).
 fn left_as_is(
     options: &FairOptions,
     source: Option<ToleranceSource>,
@@ -776,11 +790,7 @@ fn finish<T: Send>(
         curve: outcome.curve.as_ref(),
         tangents: outcome.tangents.as_deref(),
     };
-    let (after, side) = if input.len() < MEASURE_BESIDE_FROM {
-        (measure(), beside(provisional))
-    } else {
-        rayon::join(measure, || beside(provisional))
-    };
+    let (after, side) = beside_if_long(input.len(), measure, || beside(provisional));
     let mut after = after?;
     let mut kept = true;
     if options.keep_clean

@@ -135,13 +135,11 @@ pub fn fair_space(name: &str, input: &SpaceSeq, options: &FairOptions) -> Result
     super::check_options(m, input.is_closed(), options)?;
     let unit_scale = unit_scale_xyz(input.points());
     // The input's measures and the method are independent (no space method checks single
-    // moves): on long curves the measures take the core a method's serial solve leaves idle.
+    // moves).
     let measure = || SpaceMetrics::of_seq(&scaled_seq(input, 1.0 / unit_scale)?);
-    let (before, ran) = if input.len() < super::MEASURE_BESIDE_FROM {
-        (measure(), run_method(m, input, options, unit_scale))
-    } else {
-        rayon::join(measure, || run_method(m, input, options, unit_scale))
-    };
+    let (before, ran) = super::beside_if_long(input.len(), measure, || {
+        run_method(m, input, options, unit_scale)
+    });
     let before = before?;
     let Ran {
         outcome,
@@ -174,9 +172,8 @@ fn run_method(
     let closed = input.is_closed();
     let noise = NoiseMeasure::of(input.points(), closed);
     let sigma = noise.sigma(Spread::of_space(input.points()));
-    let (resolved, source) =
+    let (mut resolved, source) =
         super::resolve_tolerance(m, options, sigma, input.scale(), input.len())?;
-    let mut resolved = resolved;
     let unchanged = super::left_as_is(&resolved, source, input.len(), closed, || {
         noise.correlation()
     });

@@ -153,11 +153,13 @@ impl SymBanded {
     /// # Errors
     /// [`Error::Singular`] for a non-finite pivot (NaN or infinite entries).
     pub fn factorize_regularized(&mut self, delta: f64) -> Result<usize> {
-        match self.bw {
-            7 => self.factorize_regularized_fixed::<7>(delta),
-            11 => self.factorize_regularized_fixed::<11>(delta),
-            _ => self.factorize_regularized_rows(0, self.n, delta),
-        }
+        let regularized = match self.bw {
+            7 => self.factorize_regularized_fixed::<7>(delta)?,
+            11 => self.factorize_regularized_fixed::<11>(delta)?,
+            _ => self.factorize_regularized_rows(self.n, delta)?,
+        };
+        self.factored = true;
+        Ok(regularized)
     }
 
     /// [`SymBanded::factorize_regularized`] for a half-bandwidth known at compile time
@@ -167,8 +169,7 @@ impl SymBanded {
     fn factorize_regularized_fixed<const BW: usize>(&mut self, delta: f64) -> Result<usize> {
         let (n, w) = (self.n, BW + 1);
         let head = n.min(BW);
-        let mut regularized = self.factorize_regularized_rows(0, head, delta)?;
-        self.factored = false;
+        let mut regularized = self.factorize_regularized_rows(head, delta)?;
         let mut scaled = [0.0_f64; BW];
         for i in head..n {
             let lo = i - BW;
@@ -189,17 +190,16 @@ impl SymBanded {
             }
             win[row] = floored_pivot(d, delta, i, &mut regularized)?;
         }
-        self.factored = true;
         Ok(regularized)
     }
 
-    /// Rows `from..to` of [`SymBanded::factorize_regularized`] (the rows before `from`
-    /// factorised already); marks the matrix factorised.
-    fn factorize_regularized_rows(&mut self, from: usize, to: usize, delta: f64) -> Result<usize> {
+    /// The first `rows` rows of [`SymBanded::factorize_regularized`], whatever the
+    /// bandwidth; the count of floored pivots.
+    fn factorize_regularized_rows(&mut self, rows: usize, delta: f64) -> Result<usize> {
         let (bw, w) = (self.bw, self.bw + 1);
         let mut scaled = vec![0.0_f64; bw];
         let mut regularized = 0;
-        for i in from..to {
+        for i in 0..rows {
             let lo = i.saturating_sub(bw);
             let m = i - lo;
             // scaled[j - lo] = L[i][j]·D[j], before the division by D[j].
@@ -218,7 +218,6 @@ impl SymBanded {
             }
             self.band[i * w] = floored_pivot(d, delta, i, &mut regularized)?;
         }
-        self.factored = true;
         Ok(regularized)
     }
 
@@ -419,7 +418,7 @@ mod tests {
                     }
                 }
                 let mut general = a.clone();
-                let floored_general = general.factorize_regularized_rows(0, n, 0.5).unwrap();
+                let floored_general = general.factorize_regularized_rows(n, 0.5).unwrap();
                 let floored = a.factorize_regularized(0.5).unwrap();
                 assert!(n < 5 || floored > 0, "{bw} {n}");
                 assert_eq!(floored, floored_general, "{bw} {n}");

@@ -333,14 +333,8 @@ impl<'a, const D: usize> Penalized<'a, D> {
     /// The residual `B y − c` of every point (zero at pinned points).
     pub(super) fn residual(&self, y: &[f64]) -> Vec<f64> {
         let mut r = vec![0.0; self.points() * D];
-        let (pinned, centres) = (self.pinned, self.centres);
-        self.design.eval_then::<D>(y, &mut r, |i, q| {
-            if pinned[i] {
-                [0.0; D]
-            } else {
-                std::array::from_fn(|a| q[a] - centres[i * D + a])
-            }
-        });
+        self.design
+            .residual::<D>(y, self.centres, Some(self.pinned), &mut r);
         r
     }
 
@@ -551,18 +545,33 @@ fn smooth_log_weights(weights: &[f64], unit: f64, closed: bool, lengths: f64) ->
 
 /// `f(w)` for every weight, computed once for each run of equal weights.
 fn per_run<T: Copy>(weights: &[f64], f: impl Fn(f64) -> T) -> Vec<T> {
-    let mut last: Option<(f64, T)> = None;
-    weights
-        .iter()
-        .map(|&w| match last {
+    let mut cache = RunCache::default();
+    weights.iter().map(|&w| cache.get(w, &f)).collect()
+}
+
+/// The last weight and `f` of it: along weights that come in runs of equal values (as the
+/// local weights' rounds leave them), `f` is computed once a run.
+struct RunCache<T> {
+    last: Option<(f64, T)>,
+}
+
+impl<T> Default for RunCache<T> {
+    fn default() -> Self {
+        RunCache { last: None }
+    }
+}
+
+impl<T: Copy> RunCache<T> {
+    fn get(&mut self, w: f64, f: impl Fn(f64) -> T) -> T {
+        match self.last {
             Some((lw, v)) if lw == w => v,
             _ => {
                 let v = f(w);
-                last = Some((w, v));
+                self.last = Some((w, v));
                 v
             }
-        })
-        .collect()
+        }
+    }
 }
 
 /// One knot span's share of `Σ_i |(B y)_i − c_i|²` over the free points on it, as a
@@ -686,20 +695,13 @@ impl<const D: usize> Windows<D> {
     /// values, and a power per point was most of a round's time at 10⁶ points).
     fn significant(&self, weights: &[f64], unit: f64, threshold: f64) -> Vec<usize> {
         let n = self.n();
+        let half_of = |w: f64| self.half_width((w / unit).powf(-1.0 / 6.0));
         let mut marked = vec![0; n];
         let piece = |from: usize, out: &mut [usize]| {
-            let mut last: Option<(f64, usize)> = None;
+            let mut halves = RunCache::default();
             for (k, o) in out.iter_mut().enumerate() {
                 let i = from + k;
-                let w = weights[i];
-                let half = match last {
-                    Some((lw, h)) if lw == w => h,
-                    _ => {
-                        let h = self.half_width((w / unit).powf(-1.0 / 6.0));
-                        last = Some((w, h));
-                        h
-                    }
-                };
+                let half = halves.get(weights[i], half_of);
                 let (sum, count) = self.sum(i, half);
                 if count == 0 {
                     continue;

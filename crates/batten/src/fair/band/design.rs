@@ -121,7 +121,6 @@ impl SplineMap {
                 // Blocks right of the diagonal block hold no entry of the lower triangle.
                 for l in 0..=k {
                     if any_held && (held[f + k] || held[f + l]) {
-                        acc[k][l] = [[0.0; D]; D];
                         continue;
                     }
                     let c0 = (f + l) * D;
@@ -132,12 +131,9 @@ impl SplineMap {
                             }
                         }
                     }
-                    acc[k][l] = [[0.0; D]; D];
-                }
-                for l in k + 1..4 {
-                    acc[k][l] = [[0.0; D]; D];
                 }
             }
+            *acc = [[[[0.0; D]; D]; 4]; 4];
         };
         let mut current = None;
         for (i, mb) in blocks.iter().enumerate() {
@@ -223,6 +219,24 @@ impl Design {
                 .collect(),
             Design::Spline(s) => map_indices(s.first.len(), |i| f(i, s.point::<D>(i, x))),
         }
+    }
+
+    /// `out = B x − c` (flat, `c` the ball centres `centres`), zero at the points `pinned`
+    /// marks, where given.
+    pub(super) fn residual<const D: usize>(
+        &self,
+        x: &[f64],
+        centres: &[f64],
+        pinned: Option<&[bool]>,
+        out: &mut [f64],
+    ) {
+        self.eval_then::<D>(x, out, |i, q| {
+            if pinned.is_some_and(|p| p[i]) {
+                [0.0; D]
+            } else {
+                std::array::from_fn(|a| q[a] - centres[i * D + a])
+            }
+        });
     }
 
     /// `out_i = then(i, (B x)_i)` for every point `i` (flat, `D` numbers a point): what a

@@ -68,10 +68,8 @@ pub(super) struct Energy<const D: usize> {
 /// The chord lengths of `shape`, cyclic when closed.
 pub(super) fn chords_of<const D: usize>(shape: &[[f64; D]], closed: bool) -> Vec<f64> {
     let n = shape.len();
-    // From the first coordinate's size (what `hypot(0, x)` gives): one `hypot` fewer.
     map_indices(if closed { n } else { n - 1 }, |i| {
-        let (p, q) = (&shape[i], &shape[(i + 1) % n]);
-        (1..D).fold((p[0] - q[0]).abs(), |acc, a| acc.hypot(p[a] - q[a]))
+        super::distance(&shape[i], &shape[(i + 1) % n])
     })
 }
 

@@ -509,9 +509,7 @@ impl<'p, 'a, const D: usize> Ipm<'p, 'a, D> {
             None => start::<D>(&p.centres, pinned),
         };
         let mut off = vec![0.0; n * D];
-        design.eval_then::<D>(&y, &mut off, |i, q| {
-            std::array::from_fn(|a| q[a] - p.centres[i * D + a])
-        });
+        design.residual::<D>(&y, &p.centres, None, &mut off);
         let sig: Vec<f64> = (0..n)
             .map(|i| {
                 if pinned[i] {

@@ -60,9 +60,7 @@ pub(super) fn solve<const D: usize>(
     let mut iterations = 0;
     let mut r = vec![0.0; n * D];
     let mut r0 = vec![0.0; n * D];
-    p.design.eval_then::<D>(start, &mut r0, |i, q| {
-        std::array::from_fn(|a| q[a] - p.centres[i * D + a])
-    });
+    p.design.residual::<D>(start, &p.centres, None, &mut r0);
     for _ in 0..MAX_ROUNDS {
         let set: Vec<usize> = (0..n).filter(|&i| in_set[i]).collect();
         let design = Design::Spline(SplineMap {
@@ -89,13 +87,8 @@ pub(super) fn solve<const D: usize>(
         };
         let sol = solve_all(&sub)?;
         iterations += sol.iterations;
-        p.design.eval_then::<D>(&sol.y, &mut r, |i, q| {
-            if p.pinned[i] {
-                [0.0; D]
-            } else {
-                std::array::from_fn(|a| q[a] - p.centres[i * D + a])
-            }
-        });
+        p.design
+            .residual::<D>(&sol.y, &p.centres, Some(p.pinned), &mut r);
         let outside =
             (0..n).any(|i| !in_set[i] && !p.pinned[i] && norm2(&r[i * D..(i + 1) * D]) > 1.0);
         if !outside {
