@@ -348,7 +348,14 @@ fn fair_points<const D: usize>(
     };
     for pass in 0..params.passes {
         let energy = form.energy(&shape, &reference, pass_metric(pass, params));
+        // A pass before the last gives only the next pass's reference: a looser stopping rule.
+        let gap_rel = if pass + 1 < params.passes {
+            solver::INTERMEDIATE_GAP_REL
+        } else {
+            solver::GAP_REL
+        };
         let problem = band_problem(&form, &energy, &reference, &scaled, params.max_iterations);
+        let problem = Problem { gap_rel, ..problem };
         let sol = solve(&problem)?;
         stages.record(&sol, pass + 1, &mut shape);
         reference = form.next_reference(&reference, &scaled, &sol);
@@ -515,6 +522,7 @@ fn band_problem<'a, const D: usize>(
         pinned: &form.pinned,
         start: form.start(reference),
         max_iterations,
+        gap_rel: solver::GAP_REL,
         fidelity: Vec::new(),
     }
 }

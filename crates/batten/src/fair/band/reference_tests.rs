@@ -14,7 +14,7 @@ use clarabel::solver::{
 
 use super::design::Design;
 use super::energy::{Energy, Metric};
-use super::solver::{Problem, solve};
+use super::solver::{GAP_REL, Problem, solve};
 
 /// Noisy samples of a wavy curve and the clean samples (deterministic: a linear congruential
 /// generator).
@@ -246,6 +246,7 @@ fn check(n: usize, closed: bool, metric: Metric, held_per_end: usize) {
         pinned: &held,
         start: None,
         max_iterations: 500,
+        gap_rel: GAP_REL,
         fidelity: Vec::new(),
     };
     let reference = clarabel_objective(&energy, &problem, &s);
@@ -378,6 +379,7 @@ impl SplineCase {
             pinned: &self.pinned,
             start: Some(vec![0.0; self.s.len()]),
             max_iterations: 500,
+            gap_rel: GAP_REL,
             fidelity: Vec::new(),
         }
     }

@@ -58,7 +58,12 @@ const OBJECTIVE_FLOOR: f64 = 1e-12;
 const GRADIENT_FLOOR: f64 = 1e-9;
 /// Stop when the surrogate duality gap is below this fraction of the objective (or of 1).
 pub(super) const GAP_REL: f64 = 1e-9;
-/// The lowest complementarity gap a corrector aims at, as a fraction of [`GAP_REL`].
+/// The same for a pass whose result only gives the next pass its reference (its tangents
+/// and the start of its anchor): the energy is right to this fraction, far inside what the
+/// next pass's re-weighting changes, and the interior point's last third of iterations,
+/// which only add digits, is saved.
+pub(super) const INTERMEDIATE_GAP_REL: f64 = 1e-5;
+/// The lowest complementarity gap a corrector aims at, as a fraction of the stopping rule's.
 const GAP_TARGET_FLOOR: f64 = 0.1;
 /// When rounding stops progress, the run still counts as converged if the gap is below this
 /// fraction of the objective.
@@ -109,6 +114,9 @@ pub(super) struct Problem<'a, const D: usize> {
     pub start: Option<Vec<f64>>,
     /// Newton steps allowed.
     pub max_iterations: usize,
+    /// The stopping rule: the surrogate duality gap relative to `max(f, 1)` ([`GAP_REL`],
+    /// or [`INTERMEDIATE_GAP_REL`] for a pass that is not the last).
+    pub gap_rel: f64,
     /// Weights `μ_i` of the data term `Σ μ_i |y_i − c_i|²` added to the objective, one per
     /// point (empty: none).
     pub fidelity: Vec<f64>,
@@ -377,7 +385,7 @@ pub(super) fn solve_all<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> 
             dual_ratio,
         } = ipm.residuals();
         last_gap = gap / scale;
-        let gap_ok = gap <= GAP_REL * scale;
+        let gap_ok = gap <= p.gap_rel * scale;
         if gap_ok && dual_ratio <= 1.0 {
             converged = true;
             break;
@@ -421,7 +429,7 @@ pub(super) fn solve_all<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> 
         // gap remove; pushing the gap on towards zero instead makes the Newton matrix
         // singular (λ/σ without bound at the band's edge), and the residual then stays where
         // rounding leaves it while the points drift along the energy's flattest directions.
-        let target = (centring * mu).max(GAP_TARGET_FLOOR * GAP_REL * scale / free as f64);
+        let target = (centring * mu).max(GAP_TARGET_FLOOR * p.gap_rel * scale / free as f64);
         if ipm.corrector(alpha_aff, target).is_err() {
             break;
         }
@@ -437,8 +445,9 @@ pub(super) fn solve_all<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> 
         ipm.advance(alpha);
     }
     // Stopped short of the stopping rule (by rounding): still counts as converged when the
-    // gap is small enough for the objective to be right to `ACCEPT_GAP_REL`.
-    converged |= last_gap <= ACCEPT_GAP_REL;
+    // gap is small enough for the objective to be right to `ACCEPT_GAP_REL` (or to the
+    // problem's own rule, when that is looser).
+    converged |= last_gap <= ACCEPT_GAP_REL.max(p.gap_rel);
     Ok(ipm.finish(iterations, last_gap, converged))
 }
 

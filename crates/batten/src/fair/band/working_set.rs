@@ -83,6 +83,7 @@ pub(super) fn solve<const D: usize>(
             pinned: &pinned,
             start: Some(y_start.clone()),
             max_iterations: p.max_iterations.saturating_sub(iterations),
+            gap_rel: p.gap_rel,
             fidelity: Vec::new(),
         };
         let sol = solve_all(&sub)?;
@@ -137,6 +138,7 @@ pub(super) fn solve<const D: usize>(
         pinned: p.pinned,
         start: Some(y_start),
         max_iterations: p.max_iterations.saturating_sub(iterations),
+        gap_rel: p.gap_rel,
         fidelity: p.fidelity.clone(),
     };
     let mut sol = solve_all(&full)?;
