@@ -159,16 +159,28 @@ proptest! {
             // that residual leaves them free to about 1e-4·D, and each pass takes its metric
             // from the last. Over 64 random motions and CI's two regression seeds the points
             // agreed to 1.3e-11·D (median) and 2.8e-9·D (90th percentile), at most 7.1e-5·D
-            // (2.5e-4·D without the speed term), with the energies of every pass within 1e-8.
+            // (2.5e-4·D without the speed term).
             prop_assert!(
                 off <= 1e-3 * scale * tol,
                 "{method}: off by {off:e} at scale {scale}"
             );
-            // band's energies are in units of the tolerance and the spacing: scale free.
+            // band's energies are in units of the tolerance and the spacing: scale free. A
+            // pass before the last stops at a duality gap of 1e-5 of max(E, 1) (its result
+            // only gives the next pass its reference), so its energy is compared to that.
+            // The last pass and the debiasing stage stop at 1e-9, but their energies are
+            // those of metrics taken from the passes before, known to that gap: over 1000
+            // random motions they agreed to 3.6e-6 (relative), against 1e-8 when every pass
+            // stopped at 1e-9.
             let band_energies = if method == "band" { base.report.history.len() } else { 0 };
-            for (a, b) in base.report.history.iter().zip(&out.report.history).take(band_energies) {
-                let rel = (a.measure - b.measure).abs() / a.measure.abs().max(f64::MIN_POSITIVE);
-                prop_assert!(rel <= 1e-7, "{method}: energy {} against {}", a.measure, b.measure);
+            let last_pass = band_energies.saturating_sub(2);
+            for (k, (a, b)) in base.report.history.iter().zip(&out.report.history).take(band_energies).enumerate() {
+                let diff = (a.measure - b.measure).abs();
+                if k < last_pass {
+                    prop_assert!(diff <= 2e-5 * a.measure.abs().max(1.0), "{method}: pass {k} energy {} against {}", a.measure, b.measure);
+                } else {
+                    let rel = diff / a.measure.abs().max(f64::MIN_POSITIVE);
+                    prop_assert!(rel <= 1e-5, "{method}: stage {k} energy {} against {}", a.measure, b.measure);
+                }
             }
         }
     }
