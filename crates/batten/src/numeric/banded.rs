@@ -1,3 +1,4 @@
+use super::banded_split::Split;
 use super::{Linear, PIVOT_REL};
 use crate::error::{Error, Result};
 
@@ -8,10 +9,14 @@ use crate::error::{Error, Result};
 /// systems of smoothing splines (bw = 2) cost O(n).
 #[derive(Clone, Debug)]
 pub struct SymBanded {
-    n: usize,
-    bw: usize,
-    band: Vec<f64>,
-    factored: bool,
+    pub(super) n: usize,
+    pub(super) bw: usize,
+    pub(super) band: Vec<f64>,
+    pub(super) factored: bool,
+    /// The factors of [`SymBanded::factorize_split`] (kept between factorisations, so that
+    /// their storage is reused), and whether they are the current ones.
+    pub(super) split: Option<Box<Split>>,
+    pub(super) split_active: bool,
 }
 
 impl SymBanded {
@@ -22,6 +27,8 @@ impl SymBanded {
             bw,
             band: vec![0.0; n * (bw + 1)],
             factored: false,
+            split: None,
+            split_active: false,
         }
     }
 
@@ -101,6 +108,7 @@ impl SymBanded {
             _ => {}
         }
         self.factored = true;
+        self.split_active = false;
         Ok(())
     }
 
@@ -142,6 +150,7 @@ impl SymBanded {
         );
         self.band.copy_from_slice(&other.band);
         self.factored = false;
+        self.split_active = false;
     }
 
     /// Factorise as `L D Lᵀ` with static regularisation, for the positive semidefinite
@@ -159,6 +168,7 @@ impl SymBanded {
             _ => self.factorize_regularized_rows(self.n, delta)?,
         };
         self.factored = true;
+        self.split_active = false;
         Ok(regularized)
     }
 
@@ -223,7 +233,7 @@ impl SymBanded {
 
     /// The factor entry `L[i][j]` (i > j, within the band) after [`SymBanded::factorize`].
     pub fn l(&self, i: usize, j: usize) -> f64 {
-        debug_assert!(self.factored);
+        debug_assert!(self.factored && !self.split_active);
         if i == j {
             1.0
         } else if i < j || i - j > self.bw {
@@ -235,7 +245,7 @@ impl SymBanded {
 
     /// The pivot `D[i]` after [`SymBanded::factorize`].
     pub fn d(&self, i: usize) -> f64 {
-        debug_assert!(self.factored);
+        debug_assert!(self.factored && !self.split_active);
         self.band[i * (self.bw + 1)]
     }
 
@@ -258,16 +268,42 @@ impl SymBanded {
                 expected: self.n,
             });
         }
-        match self.bw {
-            7 => self.substitute::<7, T>(rhs),
-            11 => self.substitute::<11, T>(rhs),
-            _ => self.substitute_any(rhs),
+        if self.split_active
+            && let Some(split) = &self.split
+        {
+            split.solve(rhs);
+            return Ok(());
         }
+        self.forward(rhs);
+        self.backward(rhs);
         Ok(())
     }
 
-    /// The forward and back substitutions of [`SymBanded::solve_in_place`], any bandwidth.
-    fn substitute_any<T: Linear>(&self, rhs: &mut [T]) {
+    /// The forward substitution `L z = rhs` of [`SymBanded::solve_in_place`], in place.
+    pub(super) fn forward<T: Linear>(&self, rhs: &mut [T]) {
+        match self.bw {
+            7 if self.n > 14 => self.forward_fixed::<7, T>(rhs),
+            11 if self.n > 22 => self.forward_fixed::<11, T>(rhs),
+            _ => self.forward_any(rhs),
+        }
+    }
+
+    /// The rest of [`SymBanded::solve_in_place`] after [`SymBanded::forward`]: `x = L⁻ᵀ D⁻¹ z`,
+    /// in place.
+    pub(super) fn backward<T: Linear>(&self, rhs: &mut [T]) {
+        let w = self.bw + 1;
+        for (i, r) in rhs.iter_mut().enumerate() {
+            *r = *r * (1.0 / self.band[i * w]);
+        }
+        match self.bw {
+            7 if self.n > 14 => self.backward_fixed::<7, T>(rhs),
+            11 if self.n > 22 => self.backward_fixed::<11, T>(rhs),
+            _ => self.backward_any(rhs),
+        }
+    }
+
+    /// The forward substitution, any bandwidth.
+    fn forward_any<T: Linear>(&self, rhs: &mut [T]) {
         let (n, w) = (self.n, self.bw + 1);
         for i in 0..n {
             let lo = i.saturating_sub(self.bw);
@@ -277,9 +313,11 @@ impl SymBanded {
             }
             rhs[i] = s;
         }
-        for i in 0..n {
-            rhs[i] = rhs[i] * (1.0 / self.band[i * w]);
-        }
+    }
+
+    /// The back substitution `Lᵀ x = y`, any bandwidth.
+    fn backward_any<T: Linear>(&self, rhs: &mut [T]) {
+        let (n, w) = (self.n, self.bw + 1);
         for i in (0..n).rev() {
             let hi = (i + self.bw).min(n - 1);
             let mut s = rhs[i];
@@ -290,13 +328,11 @@ impl SymBanded {
         }
     }
 
-    /// [`SymBanded::substitute_any`] for a half-bandwidth `BW` known at compile time: the rows
-    /// with a full band take loops of fixed length (the same operations in the same order).
-    fn substitute<const BW: usize, T: Linear>(&self, rhs: &mut [T]) {
+    /// [`SymBanded::forward_any`] for a half-bandwidth `BW` known at compile time (`n > 2·BW`):
+    /// the rows with a full band take loops of fixed length (the same operations in the same
+    /// order).
+    fn forward_fixed<const BW: usize, T: Linear>(&self, rhs: &mut [T]) {
         let (n, w) = (self.n, BW + 1);
-        if n <= 2 * BW {
-            return self.substitute_any(rhs);
-        }
         for i in 0..BW {
             let mut s = rhs[i];
             for k in 0..i {
@@ -315,9 +351,11 @@ impl SymBanded {
             }
             rest[0] = s;
         }
-        for i in 0..n {
-            rhs[i] = rhs[i] * (1.0 / self.band[i * w]);
-        }
+    }
+
+    /// [`SymBanded::backward_any`] for a half-bandwidth `BW` known at compile time (`n > 2·BW`).
+    fn backward_fixed<const BW: usize, T: Linear>(&self, rhs: &mut [T]) {
+        let (n, w) = (self.n, BW + 1);
         for i in (n - BW..n).rev() {
             let mut s = rhs[i];
             for k in i + 1..n {
@@ -340,7 +378,7 @@ impl SymBanded {
 
 /// A pivot of [`SymBanded::factorize_regularized`]: `d`, or `delta` when `d` is below it
 /// (counted in `regularized`); the error when it is not finite.
-fn floored_pivot(d: f64, delta: f64, i: usize, regularized: &mut usize) -> Result<f64> {
+pub(super) fn floored_pivot(d: f64, delta: f64, i: usize, regularized: &mut usize) -> Result<f64> {
     if !d.is_finite() {
         return Err(Error::Singular(format!(
             "band matrix has a non-finite pivot ({i})"
@@ -355,7 +393,7 @@ fn floored_pivot(d: f64, delta: f64, i: usize, regularized: &mut usize) -> Resul
 
 /// A pivot of [`SymBanded::factorize`], or the error when it is (relatively) zero,
 /// negative or not finite.
-fn checked_pivot(d: f64, scale: f64, i: usize) -> Result<f64> {
+pub(super) fn checked_pivot(d: f64, scale: f64, i: usize) -> Result<f64> {
     if d.is_nan() || d <= PIVOT_REL * scale || !d.is_finite() {
         return Err(Error::Singular(format!(
             "band matrix is not positive definite (pivot {i})"
@@ -369,6 +407,16 @@ mod tests {
     use super::*;
 
     impl SymBanded {
+        /// The general loops of [`SymBanded::solve_in_place`], whatever the bandwidth.
+        fn substitute_any(&self, rhs: &mut [f64]) {
+            let w = self.bw + 1;
+            self.forward_any(rhs);
+            for (i, r) in rhs.iter_mut().enumerate() {
+                *r *= 1.0 / self.band[i * w];
+            }
+            self.backward_any(rhs);
+        }
+
         /// The general loops of [`SymBanded::factorize`], whatever the bandwidth (the
         /// reference of the fixed-bandwidth path).
         fn bw_general_factorize(&mut self) {

@@ -4,6 +4,7 @@
 mod band_inverse;
 mod band_lu;
 mod banded;
+mod banded_split;
 mod cyclic_banded;
 mod minimize;
 mod nelder_mead;
@@ -28,7 +29,7 @@ use crate::geom::Vec2;
 /// Values a linear solver can carry on its right-hand side: scalars and plane vectors, so that
 /// one factorisation solves for x and y together.
 pub trait Linear:
-    Copy + Default + Add<Output = Self> + Sub<Output = Self> + Mul<f64, Output = Self>
+    Copy + Default + Send + Sync + Add<Output = Self> + Sub<Output = Self> + Mul<f64, Output = Self>
 {
 }
 

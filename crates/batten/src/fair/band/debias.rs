@@ -63,7 +63,7 @@ impl Base {
     fn factorize_and_solve(mut self, y: &mut [f64]) -> Result<()> {
         match &mut self {
             Base::Open(m) => {
-                m.factorize()?;
+                m.factorize_split()?;
                 m.solve_in_place(y)
             }
             Base::Closed(m) => {

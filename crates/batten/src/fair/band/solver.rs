@@ -211,7 +211,7 @@ impl Newton {
                 for k in 0..work.n() {
                     top = top.max(work.get(k, k));
                 }
-                *exact = work.factorize_regularized(REGULARIZATION_REL * top)? == 0;
+                *exact = work.factorize_regularized_split(REGULARIZATION_REL * top)? == 0;
             }
             Newton::Closed { work } => {
                 let dim = energy.n * D;
