@@ -162,72 +162,15 @@ impl SymBanded {
     /// # Errors
     /// [`Error::Singular`] for a non-finite pivot (NaN or infinite entries).
     pub fn factorize_regularized(&mut self, delta: f64) -> Result<usize> {
-        let regularized = match self.bw {
-            7 => self.factorize_regularized_fixed::<7>(delta)?,
-            11 => self.factorize_regularized_fixed::<11>(delta)?,
-            _ => self.factorize_regularized_rows(self.n, delta)?,
-        };
+        let mut regularized = 0;
+        let mut pivot = |d: f64, i: usize| floored_pivot(d, delta, i, &mut regularized);
+        match self.bw {
+            7 => ldl_fixed::<7>(&mut self.band, self.n, &mut pivot)?,
+            11 => ldl_fixed::<11>(&mut self.band, self.n, &mut pivot)?,
+            _ => ldl_rows(&mut self.band, self.bw, self.n, &mut pivot)?,
+        }
         self.factored = true;
         self.split_active = false;
-        Ok(regularized)
-    }
-
-    /// [`SymBanded::factorize_regularized`] for a half-bandwidth known at compile time
-    /// (`band`'s Newton matrices: 7 in 2-D, 11 in 3-D): the rows past the first `BW` with
-    /// loops of fixed length over a fixed window, the same operations in the same order (the
-    /// same factors, bit for bit).
-    fn factorize_regularized_fixed<const BW: usize>(&mut self, delta: f64) -> Result<usize> {
-        let (n, w) = (self.n, BW + 1);
-        let head = n.min(BW);
-        let mut regularized = self.factorize_regularized_rows(head, delta)?;
-        let mut scaled = [0.0_f64; BW];
-        for i in head..n {
-            let lo = i - BW;
-            // Rows lo..=i; row i is the window's last.
-            let win = &mut self.band[lo * w..(i + 1) * w];
-            let row = BW * w;
-            for jj in 0..BW {
-                let mut s = win[row + (BW - jj)];
-                for kk in 0..jj {
-                    s -= scaled[kk] * win[jj * w + (jj - kk)];
-                }
-                scaled[jj] = s;
-                win[row + (BW - jj)] = s / win[jj * w];
-            }
-            let mut d = win[row];
-            for (kk, v) in scaled.iter().enumerate() {
-                d -= v * win[row + (BW - kk)];
-            }
-            win[row] = floored_pivot(d, delta, i, &mut regularized)?;
-        }
-        Ok(regularized)
-    }
-
-    /// The first `rows` rows of [`SymBanded::factorize_regularized`], whatever the
-    /// bandwidth; the count of floored pivots.
-    fn factorize_regularized_rows(&mut self, rows: usize, delta: f64) -> Result<usize> {
-        let (bw, w) = (self.bw, self.bw + 1);
-        let mut scaled = vec![0.0_f64; bw];
-        let mut regularized = 0;
-        for i in 0..rows {
-            let lo = i.saturating_sub(bw);
-            let m = i - lo;
-            // scaled[j - lo] = L[i][j]·D[j], before the division by D[j].
-            for j in lo..i {
-                let mut s = self.band[i * w + (i - j)];
-                let klo = lo.max(j.saturating_sub(bw));
-                for k in klo..j {
-                    s -= scaled[k - lo] * self.band[j * w + (j - k)];
-                }
-                scaled[j - lo] = s;
-                self.band[i * w + (i - j)] = s / self.band[j * w];
-            }
-            let mut d = self.band[i * w];
-            for (k, v) in scaled[..m].iter().enumerate() {
-                d -= v * self.band[i * w + (i - (lo + k))];
-            }
-            self.band[i * w] = floored_pivot(d, delta, i, &mut regularized)?;
-        }
         Ok(regularized)
     }
 
@@ -271,7 +214,7 @@ impl SymBanded {
         if self.split_active
             && let Some(split) = &self.split
         {
-            split.solve(rhs);
+            split.solve(&self.band, self.bw, rhs);
             return Ok(());
         }
         self.forward(rhs);
@@ -281,98 +224,177 @@ impl SymBanded {
 
     /// The forward substitution `L z = rhs` of [`SymBanded::solve_in_place`], in place.
     pub(super) fn forward<T: Linear>(&self, rhs: &mut [T]) {
-        match self.bw {
-            7 if self.n > 14 => self.forward_fixed::<7, T>(rhs),
-            11 if self.n > 22 => self.forward_fixed::<11, T>(rhs),
-            _ => self.forward_any(rhs),
-        }
+        forward_sub(&self.band, self.bw, rhs);
     }
 
     /// The rest of [`SymBanded::solve_in_place`] after [`SymBanded::forward`]: `x = L⁻ᵀ D⁻¹ z`,
     /// in place.
     pub(super) fn backward<T: Linear>(&self, rhs: &mut [T]) {
-        let w = self.bw + 1;
-        for (i, r) in rhs.iter_mut().enumerate() {
-            *r = *r * (1.0 / self.band[i * w]);
-        }
-        match self.bw {
-            7 if self.n > 14 => self.backward_fixed::<7, T>(rhs),
-            11 if self.n > 22 => self.backward_fixed::<11, T>(rhs),
-            _ => self.backward_any(rhs),
-        }
+        backward_sub(&self.band, self.bw, rhs);
     }
+}
 
-    /// The forward substitution, any bandwidth.
-    fn forward_any<T: Linear>(&self, rhs: &mut [T]) {
-        let (n, w) = (self.n, self.bw + 1);
-        for i in 0..n {
-            let lo = i.saturating_sub(self.bw);
-            let mut s = rhs[i];
-            for k in lo..i {
-                s = s - rhs[k] * self.band[i * w + (i - k)];
+/// Rows `0..n` of the regularised `L D Lᵀ` factorisation on band storage of half-bandwidth
+/// `BW` known at compile time (`band`'s Newton matrices: 7 in 2-D, 11 in 3-D), `pivot` taking
+/// each pivot: the rows past the first `BW` with loops of fixed length over a fixed window,
+/// the same operations in the same order as [`ldl_rows`] (the same factors, bit for bit).
+pub(super) fn ldl_fixed<const BW: usize>(
+    band: &mut [f64],
+    n: usize,
+    pivot: &mut impl FnMut(f64, usize) -> Result<f64>,
+) -> Result<()> {
+    let w = BW + 1;
+    let head = n.min(BW);
+    ldl_rows(band, BW, head, pivot)?;
+    let mut scaled = [0.0_f64; BW];
+    for i in head..n {
+        let lo = i - BW;
+        // Rows lo..=i; row i is the window's last.
+        let win = &mut band[lo * w..(i + 1) * w];
+        let row = BW * w;
+        for jj in 0..BW {
+            let mut s = win[row + (BW - jj)];
+            for kk in 0..jj {
+                s -= scaled[kk] * win[jj * w + (jj - kk)];
             }
-            rhs[i] = s;
+            scaled[jj] = s;
+            win[row + (BW - jj)] = s / win[jj * w];
         }
+        let mut d = win[row];
+        for (kk, v) in scaled.iter().enumerate() {
+            d -= v * win[row + (BW - kk)];
+        }
+        win[row] = pivot(d, i)?;
     }
+    Ok(())
+}
 
-    /// The back substitution `Lᵀ x = y`, any bandwidth.
-    fn backward_any<T: Linear>(&self, rhs: &mut [T]) {
-        let (n, w) = (self.n, self.bw + 1);
-        for i in (0..n).rev() {
-            let hi = (i + self.bw).min(n - 1);
-            let mut s = rhs[i];
-            for k in i + 1..=hi {
-                s = s - rhs[k] * self.band[k * w + (k - i)];
+/// The first `rows` rows of the regularised factorisation on band storage of half-bandwidth
+/// `bw`, whatever it is (`L[i][k]·D[k]` kept before its division, half the multiplications
+/// of [`SymBanded::factorize`]).
+pub(super) fn ldl_rows(
+    band: &mut [f64],
+    bw: usize,
+    rows: usize,
+    pivot: &mut impl FnMut(f64, usize) -> Result<f64>,
+) -> Result<()> {
+    let w = bw + 1;
+    let mut scaled = vec![0.0_f64; bw];
+    for i in 0..rows {
+        let lo = i.saturating_sub(bw);
+        let m = i - lo;
+        // scaled[j - lo] = L[i][j]·D[j], before the division by D[j].
+        for j in lo..i {
+            let mut s = band[i * w + (i - j)];
+            let klo = lo.max(j.saturating_sub(bw));
+            for k in klo..j {
+                s -= scaled[k - lo] * band[j * w + (j - k)];
             }
-            rhs[i] = s;
+            scaled[j - lo] = s;
+            band[i * w + (i - j)] = s / band[j * w];
         }
+        let mut d = band[i * w];
+        for (k, v) in scaled[..m].iter().enumerate() {
+            d -= v * band[i * w + (i - (lo + k))];
+        }
+        band[i * w] = pivot(d, i)?;
     }
+    Ok(())
+}
 
-    /// [`SymBanded::forward_any`] for a half-bandwidth `BW` known at compile time (`n > 2·BW`):
-    /// the rows with a full band take loops of fixed length (the same operations in the same
-    /// order).
-    fn forward_fixed<const BW: usize, T: Linear>(&self, rhs: &mut [T]) {
-        let (n, w) = (self.n, BW + 1);
-        for i in 0..BW {
-            let mut s = rhs[i];
-            for k in 0..i {
-                s = s - rhs[k] * self.band[i * w + (i - k)];
-            }
-            rhs[i] = s;
-        }
-        for i in BW..n {
-            let lo = i - BW;
-            let row = &self.band[i * w..(i + 1) * w];
-            let (before, rest) = rhs.split_at_mut(i);
-            let before = &before[lo..];
-            let mut s = rest[0];
-            for kk in 0..BW {
-                s = s - before[kk] * row[BW - kk];
-            }
-            rest[0] = s;
-        }
+/// The forward substitution `L z = rhs` with the factors on band storage of half-bandwidth
+/// `bw` (as many rows as `rhs`), in place.
+pub(super) fn forward_sub<T: Linear>(band: &[f64], bw: usize, rhs: &mut [T]) {
+    let n = rhs.len();
+    match bw {
+        7 if n > 14 => forward_fixed::<7, T>(band, rhs),
+        11 if n > 22 => forward_fixed::<11, T>(band, rhs),
+        _ => forward_any(band, bw, rhs),
     }
+}
 
-    /// [`SymBanded::backward_any`] for a half-bandwidth `BW` known at compile time (`n > 2·BW`).
-    fn backward_fixed<const BW: usize, T: Linear>(&self, rhs: &mut [T]) {
-        let (n, w) = (self.n, BW + 1);
-        for i in (n - BW..n).rev() {
-            let mut s = rhs[i];
-            for k in i + 1..n {
-                s = s - rhs[k] * self.band[k * w + (k - i)];
-            }
-            rhs[i] = s;
+/// `x = L⁻ᵀ D⁻¹ z` with the factors on band storage of half-bandwidth `bw`, in place.
+pub(super) fn backward_sub<T: Linear>(band: &[f64], bw: usize, rhs: &mut [T]) {
+    let (n, w) = (rhs.len(), bw + 1);
+    for (i, r) in rhs.iter_mut().enumerate() {
+        *r = *r * (1.0 / band[i * w]);
+    }
+    match bw {
+        7 if n > 14 => backward_fixed::<7, T>(band, rhs),
+        11 if n > 22 => backward_fixed::<11, T>(band, rhs),
+        _ => backward_any(band, bw, rhs),
+    }
+}
+
+/// The forward substitution, any bandwidth.
+fn forward_any<T: Linear>(band: &[f64], bw: usize, rhs: &mut [T]) {
+    let (n, w) = (rhs.len(), bw + 1);
+    for i in 0..n {
+        let lo = i.saturating_sub(bw);
+        let mut s = rhs[i];
+        for k in lo..i {
+            s = s - rhs[k] * band[i * w + (i - k)];
         }
-        for i in (0..n - BW).rev() {
-            let (head, after) = rhs.split_at_mut(i + 1);
-            let after = &after[..BW];
-            let rows = &self.band[(i + 1) * w..(i + 1 + BW) * w];
-            let mut s = head[i];
-            for kk in 1..=BW {
-                s = s - after[kk - 1] * rows[(kk - 1) * w + kk];
-            }
-            head[i] = s;
+        rhs[i] = s;
+    }
+}
+
+/// The back substitution `Lᵀ x = y`, any bandwidth.
+fn backward_any<T: Linear>(band: &[f64], bw: usize, rhs: &mut [T]) {
+    let (n, w) = (rhs.len(), bw + 1);
+    for i in (0..n).rev() {
+        let hi = (i + bw).min(n - 1);
+        let mut s = rhs[i];
+        for k in i + 1..=hi {
+            s = s - rhs[k] * band[k * w + (k - i)];
         }
+        rhs[i] = s;
+    }
+}
+
+/// [`forward_any`] for a half-bandwidth `BW` known at compile time (`n > 2·BW`): the rows
+/// with a full band take loops of fixed length (the same operations in the same order).
+fn forward_fixed<const BW: usize, T: Linear>(band: &[f64], rhs: &mut [T]) {
+    let (n, w) = (rhs.len(), BW + 1);
+    for i in 0..BW {
+        let mut s = rhs[i];
+        for k in 0..i {
+            s = s - rhs[k] * band[i * w + (i - k)];
+        }
+        rhs[i] = s;
+    }
+    for i in BW..n {
+        let lo = i - BW;
+        let row = &band[i * w..(i + 1) * w];
+        let (before, rest) = rhs.split_at_mut(i);
+        let before = &before[lo..];
+        let mut s = rest[0];
+        for kk in 0..BW {
+            s = s - before[kk] * row[BW - kk];
+        }
+        rest[0] = s;
+    }
+}
+
+/// [`backward_any`] for a half-bandwidth `BW` known at compile time (`n > 2·BW`).
+fn backward_fixed<const BW: usize, T: Linear>(band: &[f64], rhs: &mut [T]) {
+    let (n, w) = (rhs.len(), BW + 1);
+    for i in (n - BW..n).rev() {
+        let mut s = rhs[i];
+        for k in i + 1..n {
+            s = s - rhs[k] * band[k * w + (k - i)];
+        }
+        rhs[i] = s;
+    }
+    for i in (0..n - BW).rev() {
+        let (head, after) = rhs.split_at_mut(i + 1);
+        let after = &after[..BW];
+        let rows = &band[(i + 1) * w..(i + 1 + BW) * w];
+        let mut s = head[i];
+        for kk in 1..=BW {
+            s = s - after[kk - 1] * rows[(kk - 1) * w + kk];
+        }
+        head[i] = s;
     }
 }
 
@@ -410,11 +432,11 @@ mod tests {
         /// The general loops of [`SymBanded::solve_in_place`], whatever the bandwidth.
         fn substitute_any(&self, rhs: &mut [f64]) {
             let w = self.bw + 1;
-            self.forward_any(rhs);
+            forward_any(&self.band, self.bw, rhs);
             for (i, r) in rhs.iter_mut().enumerate() {
                 *r *= 1.0 / self.band[i * w];
             }
-            self.backward_any(rhs);
+            backward_any(&self.band, self.bw, rhs);
         }
 
         /// The general loops of [`SymBanded::factorize`], whatever the bandwidth (the
@@ -466,7 +488,11 @@ mod tests {
                     }
                 }
                 let mut general = a.clone();
-                let floored_general = general.factorize_regularized_rows(n, 0.5).unwrap();
+                let mut floored_general = 0;
+                ldl_rows(&mut general.band, bw, n, &mut |d, i| {
+                    floored_pivot(d, 0.5, i, &mut floored_general)
+                })
+                .unwrap();
                 let floored = a.factorize_regularized(0.5).unwrap();
                 assert!(n < 5 || floored > 0, "{bw} {n}");
                 assert_eq!(floored, floored_general, "{bw} {n}");
