@@ -424,6 +424,27 @@ pub(super) fn checked_pivot(d: f64, scale: f64, i: usize) -> Result<f64> {
     Ok(d)
 }
 
+/// A band matrix for the tests: diagonal `3 + sin i`, off-diagonal `0.1 cos(7i + 3j)`
+/// (positive definite), with the diagonal `1e-300` on the rows `i ≡ 4 (mod m)` when
+/// `weak_every` is `Some(m)` (to floor their pivots).
+#[cfg(test)]
+pub(super) fn test_matrix(n: usize, bw: usize, weak_every: Option<usize>) -> SymBanded {
+    let mut a = SymBanded::zeros(n, bw);
+    for i in 0..n {
+        for j in i.saturating_sub(bw)..=i {
+            let v = if i != j {
+                0.1 * ((i * 7 + j * 3) as f64).cos()
+            } else if weak_every.is_some_and(|m| i % m == 4) {
+                1e-300
+            } else {
+                3.0 + (i as f64).sin()
+            };
+            a.add(i, j, v);
+        }
+    }
+    a
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -471,22 +492,8 @@ mod tests {
     fn fixed_bandwidth_paths_match_the_general_ones() {
         for bw in [7, 11] {
             for n in [3, 7, 2 * bw, 2 * bw + 1, 60] {
-                let mut a = SymBanded::zeros(n, bw);
-                for i in 0..n {
-                    for j in i.saturating_sub(bw)..=i {
-                        let v = if i == j {
-                            // A few rows nearly singular, to floor their pivots.
-                            if i % 9 == 4 {
-                                1e-300
-                            } else {
-                                3.0 + (i as f64).sin()
-                            }
-                        } else {
-                            0.1 * ((i * 7 + j * 3) as f64).cos()
-                        };
-                        a.add(i, j, v);
-                    }
-                }
+                // A few rows nearly singular, to floor their pivots.
+                let mut a = test_matrix(n, bw, Some(9));
                 let mut general = a.clone();
                 let mut floored_general = 0;
                 ldl_rows(&mut general.band, bw, n, &mut |d, i| {
@@ -501,17 +508,7 @@ mod tests {
                 }
                 if n >= 5 {
                     // The plain factorisation (no floored pivot: a positive definite matrix).
-                    let mut spd = SymBanded::zeros(n, bw);
-                    for i in 0..n {
-                        for j in i.saturating_sub(bw)..=i {
-                            let v = if i == j {
-                                3.0 + (i as f64).sin()
-                            } else {
-                                0.1 * ((i * 7 + j * 3) as f64).cos()
-                            };
-                            spd.add(i, j, v);
-                        }
-                    }
+                    let mut spd = test_matrix(n, bw, None);
                     let mut general = spd.clone();
                     general.bw_general_factorize();
                     spd.factorize().unwrap();

@@ -394,26 +394,12 @@ impl SymBanded {
 mod tests {
     use super::*;
     use crate::geom::Vec2;
+    use crate::numeric::banded::test_matrix;
 
     /// A positive definite band matrix of `n` rows, with a few nearly singular rows when
     /// `weak`.
     fn matrix(n: usize, bw: usize, weak: bool) -> SymBanded {
-        let mut a = SymBanded::zeros(n, bw);
-        for i in 0..n {
-            for j in i.saturating_sub(bw)..=i {
-                let v = if i == j {
-                    if weak && i % 997 == 4 {
-                        1e-300
-                    } else {
-                        3.0 + (i as f64).sin()
-                    }
-                } else {
-                    0.1 * ((i * 7 + j * 3) as f64).cos()
-                };
-                a.add(i, j, v);
-            }
-        }
-        a
+        test_matrix(n, bw, weak.then_some(997))
     }
 
     /// `A x` from the unfactorised matrix.
