@@ -13,10 +13,9 @@ pub struct SymBanded {
     pub(super) bw: usize,
     pub(super) band: Vec<f64>,
     pub(super) factored: bool,
-    /// The factors of [`SymBanded::factorize_split`] (kept between factorisations, so that
-    /// their storage is reused), and whether they are the current ones.
+    /// The middle block's factors when [`SymBanded::factorize_split`] factorised the matrix
+    /// from both ends (the solve then takes that path); `None` otherwise.
     pub(super) split: Option<Box<Split>>,
-    pub(super) split_active: bool,
 }
 
 impl SymBanded {
@@ -28,7 +27,6 @@ impl SymBanded {
             band: vec![0.0; n * (bw + 1)],
             factored: false,
             split: None,
-            split_active: false,
         }
     }
 
@@ -108,7 +106,7 @@ impl SymBanded {
             _ => {}
         }
         self.factored = true;
-        self.split_active = false;
+        self.split = None;
         Ok(())
     }
 
@@ -150,7 +148,7 @@ impl SymBanded {
         );
         self.band.copy_from_slice(&other.band);
         self.factored = false;
-        self.split_active = false;
+        self.split = None;
     }
 
     /// Factorise as `L D Lᵀ` with static regularisation, for the positive semidefinite
@@ -170,13 +168,13 @@ impl SymBanded {
             _ => ldl_rows(&mut self.band, self.bw, self.n, &mut pivot)?,
         }
         self.factored = true;
-        self.split_active = false;
+        self.split = None;
         Ok(regularized)
     }
 
     /// The factor entry `L[i][j]` (i > j, within the band) after [`SymBanded::factorize`].
     pub fn l(&self, i: usize, j: usize) -> f64 {
-        debug_assert!(self.factored && !self.split_active);
+        debug_assert!(self.factored && self.split.is_none());
         if i == j {
             1.0
         } else if i < j || i - j > self.bw {
@@ -188,7 +186,7 @@ impl SymBanded {
 
     /// The pivot `D[i]` after [`SymBanded::factorize`].
     pub fn d(&self, i: usize) -> f64 {
-        debug_assert!(self.factored && !self.split_active);
+        debug_assert!(self.factored && self.split.is_none());
         self.band[i * (self.bw + 1)]
     }
 
@@ -211,26 +209,14 @@ impl SymBanded {
                 expected: self.n,
             });
         }
-        if self.split_active
-            && let Some(split) = &self.split
-        {
-            split.solve(&self.band, self.bw, rhs);
-            return Ok(());
+        match &self.split {
+            Some(split) => split.solve(&self.band, self.bw, rhs),
+            None => {
+                forward_sub(&self.band, self.bw, rhs);
+                backward_sub(&self.band, self.bw, rhs);
+            }
         }
-        self.forward(rhs);
-        self.backward(rhs);
         Ok(())
-    }
-
-    /// The forward substitution `L z = rhs` of [`SymBanded::solve_in_place`], in place.
-    pub(super) fn forward<T: Linear>(&self, rhs: &mut [T]) {
-        forward_sub(&self.band, self.bw, rhs);
-    }
-
-    /// The rest of [`SymBanded::solve_in_place`] after [`SymBanded::forward`]: `x = L⁻ᵀ D⁻¹ z`,
-    /// in place.
-    pub(super) fn backward<T: Linear>(&self, rhs: &mut [T]) {
-        backward_sub(&self.band, self.bw, rhs);
     }
 }
 

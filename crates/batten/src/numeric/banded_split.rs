@@ -23,7 +23,7 @@
 
 use super::Linear;
 use super::banded::{
-    SymBanded, backward_sub, checked_pivot, floored_pivot, forward_sub, ldl_fixed,
+    SymBanded, backward_sub, checked_pivot, floored_pivot, forward_sub, ldl_fixed, ldl_rows,
 };
 use crate::error::Result;
 
@@ -54,7 +54,7 @@ impl Pivots {
 /// What [`SymBanded::factorize_split`] keeps besides the factors, which stay in the matrix's
 /// own storage: the top part's `L D Lᵀ` in rows `0..mid`, the bottom part's `U D Uᵀ` (`U`
 /// unit upper, stored where `Uᵀ` would be) in rows `mid + bw..n`, the middle rows untouched.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub(crate) struct Split {
     /// The middle block's first row.
     mid: usize,
@@ -62,7 +62,8 @@ pub(crate) struct Split {
     /// part's first `bw` rows (row-major, `bw × bw`): zero elsewhere.
     y_top: Vec<f64>,
     y_bottom: Vec<f64>,
-    /// The middle block's Schur complement as dense `L D Lᵀ` (row-major, `D` on the diagonal).
+    /// The middle block's Schur complement, factorised as `L D Lᵀ` in band storage of
+    /// half-bandwidth `bw − 1` (dense: entry `(j, l)` at `j·bw + j − l`).
     schur: Vec<f64>,
 }
 
@@ -168,13 +169,12 @@ fn backward_up<const BW: usize, T: Linear>(band: &[f64], rhs: &mut [T]) {
 }
 
 impl Split {
-    /// Factorise `a` in place from both ends, then the middle block's Schur complement; the
-    /// count of floored pivots.
-    fn factorize<const BW: usize>(&mut self, a: &mut SymBanded, pivots: Pivots) -> Result<usize> {
+    /// Factorise `a` in place from both ends, then the middle block's Schur complement: what
+    /// the solve needs besides `a`, and the count of floored pivots.
+    fn factorize<const BW: usize>(a: &mut SymBanded, pivots: Pivots) -> Result<(Split, usize)> {
         let (n, w) = (a.n, BW + 1);
         let mid = (n - BW) / 2;
         let below = n - mid - BW;
-        self.mid = mid;
         let (top, rest) = a.band.split_at_mut(mid * w);
         let (middle, bottom) = rest.split_at_mut(BW * w);
         let first = mid + BW;
@@ -196,17 +196,15 @@ impl Split {
         // The couplings on each part's rows next to the middle block, then Y. The top's row
         // mid − BW + r meets column mid + j when j ≤ r (entry in the middle row mid + j); the
         // bottom's row r (row mid + BW + r) meets column mid + j when r ≤ j (in its own row).
-        self.y_top.clear();
-        self.y_top.resize(BW * BW, 0.0);
-        self.y_bottom.clear();
-        self.y_bottom.resize(BW * BW, 0.0);
+        let mut y_top = vec![0.0; BW * BW];
+        let mut y_bottom = vec![0.0; BW * BW];
         for r in 0..BW {
             for j in 0..BW {
                 if j <= r {
-                    self.y_top[r * BW + j] = middle[j * w + (BW + j - r)];
+                    y_top[r * BW + j] = middle[j * w + (BW + j - r)];
                 }
                 if r <= j {
-                    self.y_bottom[r * BW + j] = bottom[r * w + (BW + r - j)];
+                    y_bottom[r * BW + j] = bottom[r * w + (BW + r - j)];
                 }
             }
         }
@@ -215,7 +213,7 @@ impl Split {
             for q in 0..r {
                 let l = top[row * w + (r - q)];
                 for j in 0..BW {
-                    self.y_top[r * BW + j] -= l * self.y_top[q * BW + j];
+                    y_top[r * BW + j] -= l * y_top[q * BW + j];
                 }
             }
         }
@@ -223,53 +221,43 @@ impl Split {
             for q in r + 1..BW {
                 let u = bottom[q * w + (q - r)];
                 for j in 0..BW {
-                    self.y_bottom[r * BW + j] -= u * self.y_bottom[q * BW + j];
+                    y_bottom[r * BW + j] -= u * y_bottom[q * BW + j];
                 }
             }
         }
         // The Schur complement A_SS − Yᵀ D⁻¹ Y of both parts, lower triangle.
-        self.schur.clear();
-        self.schur.resize(BW * BW, 0.0);
+        let mut schur = vec![0.0; BW * BW];
         for j in 0..BW {
             for l in 0..=j {
-                self.schur[j * BW + l] = middle[j * w + (j - l)];
+                schur[j * BW + (j - l)] = middle[j * w + (j - l)];
             }
         }
-        let parts = [
-            (
-                &self.y_top,
-                (0..BW).map(|r| top[(mid - BW + r) * w]).collect::<Vec<_>>(),
-            ),
-            (&self.y_bottom, (0..BW).map(|r| bottom[r * w]).collect()),
-        ];
-        for (y, d) in parts {
+        // Each part's `Yᵀ D⁻¹ Y`, `d(r)` the pivot of its row next to the middle block.
+        let mut less = |y: &[f64], d: &dyn Fn(usize) -> f64| {
             for r in 0..BW {
                 for j in 0..BW {
-                    let v = y[r * BW + j] / d[r];
+                    let v = y[r * BW + j] / d(r);
                     for l in 0..=j {
-                        self.schur[j * BW + l] -= v * y[r * BW + l];
+                        schur[j * BW + (j - l)] -= v * y[r * BW + l];
                     }
                 }
             }
-        }
-        // Dense L D Lᵀ of the Schur complement, its pivots taken as the parts' are.
-        let s = &mut self.schur;
-        for i in 0..BW {
-            for j in 0..i {
-                let mut v = s[i * BW + j];
-                for k in 0..j {
-                    v -= s[i * BW + k] * s[k * BW + k] * s[j * BW + k];
-                }
-                s[i * BW + j] = v / s[j * BW + j];
-            }
-            let mut d = s[i * BW + i];
-            for k in 0..i {
-                let l = s[i * BW + k];
-                d -= l * l * s[k * BW + k];
-            }
-            s[i * BW + i] = pivots.take(d, mid + i, &mut floored)?;
-        }
-        Ok(floored)
+        };
+        less(&y_top, &|r| top[(mid - BW + r) * w]);
+        less(&y_bottom, &|r| bottom[r * w]);
+        // L D Lᵀ of the Schur complement, its pivots taken as the parts' are.
+        ldl_rows(&mut schur, BW - 1, BW, &mut |d, i| {
+            pivots.take(d, mid + i, &mut floored)
+        })?;
+        Ok((
+            Split {
+                mid,
+                y_top,
+                y_bottom,
+                schur,
+            },
+            floored,
+        ))
     }
 
     /// Solve with the factors (in `band`, half-bandwidth `bw`), in place.
@@ -300,20 +288,8 @@ impl Split {
                 *xj = *xj - zt * self.y_top[r * bw + j] - zb * self.y_bottom[r * bw + j];
             }
         }
-        let s = &self.schur;
-        for i in 0..bw {
-            for k in 0..i {
-                x[i] = x[i] - x[k] * s[i * bw + k];
-            }
-        }
-        for (i, xi) in x.iter_mut().enumerate() {
-            *xi = *xi * (1.0 / s[i * bw + i]);
-        }
-        for i in (0..bw).rev() {
-            for k in i + 1..bw {
-                x[i] = x[i] - x[k] * s[k * bw + i];
-            }
-        }
+        forward_sub(&self.schur, bw - 1, &mut x);
+        backward_sub(&self.schur, bw - 1, &mut x);
         middle.copy_from_slice(&x);
         // Each part: `z − Y x` on its rows next to the middle block, then its back
         // substitution.
@@ -375,17 +351,14 @@ impl SymBanded {
     }
 
     fn split_factorize(&mut self, pivots: Pivots) -> Result<usize> {
-        let mut split = self.split.take().unwrap_or_default();
-        self.split_active = false;
+        self.split = None;
         self.factored = false;
-        let result = match self.bw {
-            7 => split.factorize::<7>(self, pivots),
-            _ => split.factorize::<11>(self, pivots),
+        let (split, floored) = match self.bw {
+            7 => Split::factorize::<7>(self, pivots)?,
+            _ => Split::factorize::<11>(self, pivots)?,
         };
-        self.split = Some(split);
-        let floored = result?;
+        self.split = Some(Box::new(split));
         self.factored = true;
-        self.split_active = true;
         Ok(floored)
     }
 }
@@ -428,7 +401,7 @@ mod tests {
                 one.factorize().unwrap();
                 let mut split = a.clone();
                 split.factorize_split().unwrap();
-                assert!(split.split_active, "{bw} {n}");
+                assert!(split.split.is_some(), "{bw} {n}");
                 let (mut want, mut got) = (b.clone(), b.clone());
                 one.solve_in_place(&mut want).unwrap();
                 split.solve_in_place(&mut got).unwrap();
@@ -474,7 +447,7 @@ mod tests {
         one.factorize().unwrap();
         let mut split = a.clone();
         split.factorize_split().unwrap();
-        assert!(!split.split_active);
+        assert!(split.split.is_none());
         let (mut want, mut got) = (b.clone(), b.clone());
         one.solve_in_place(&mut want).unwrap();
         split.solve_in_place(&mut got).unwrap();
@@ -491,7 +464,7 @@ mod tests {
         again.factorize().unwrap();
         m.assign(&long);
         m.factorize().unwrap();
-        assert!(!m.split_active);
+        assert!(m.split.is_none());
         let b: Vec<f64> = (0..long.n()).map(|i| (i as f64).cos()).collect();
         let (mut want, mut got) = (b.clone(), b);
         again.solve_in_place(&mut want).unwrap();
