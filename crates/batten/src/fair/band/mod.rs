@@ -354,8 +354,8 @@ fn fair_points<const D: usize>(
         } else {
             solver::GAP_REL
         };
-        let problem = band_problem(&form, &energy, &reference, &scaled, params.max_iterations);
-        let problem = Problem { gap_rel, ..problem };
+        let limits = (params.max_iterations, gap_rel);
+        let problem = band_problem(&form, &energy, &reference, &scaled, limits);
         let sol = solve(&problem)?;
         stages.record(&sol, pass + 1, &mut shape);
         reference = form.next_reference(&reference, &scaled, &sol);
@@ -456,7 +456,8 @@ fn debias_stage<const D: usize>(
     // The last pass's metric, its tangents re-taken from the passes' result.
     let metric = pass_metric(params.passes - 1, params);
     let energy = form.energy(shape, reference, metric);
-    let mut problem = band_problem(form, &energy, reference, scaled, params.max_iterations);
+    let limits = (params.max_iterations, solver::GAP_REL);
+    let mut problem = band_problem(form, &energy, reference, scaled, limits);
     let fixed = form.fixed(&problem.centres);
     let fit = Penalized::new(
         &energy,
@@ -498,13 +499,13 @@ fn pass_metric(pass: usize, params: &BandParams) -> Metric {
 
 /// The band problem of `form` with the energy `energy` taken relative to `reference` (its
 /// unknowns, in units of the tolerance, flat; the input `scaled` likewise), without a data
-/// term.
+/// term; `(max_iterations, gap_rel)` its iteration limit and stopping rule.
 fn band_problem<'a, const D: usize>(
     form: &'a Form<D>,
     energy: &'a Energy<D>,
     reference: &[f64],
     scaled: &[f64],
-    max_iterations: usize,
+    (max_iterations, gap_rel): (usize, f64),
 ) -> Problem<'a, D> {
     let mut anchor = vec![0.0; reference.len()];
     energy.apply_add(reference, &mut anchor);
@@ -522,7 +523,7 @@ fn band_problem<'a, const D: usize>(
         pinned: &form.pinned,
         start: form.start(reference),
         max_iterations,
-        gap_rel: solver::GAP_REL,
+        gap_rel,
         fidelity: Vec::new(),
     }
 }
