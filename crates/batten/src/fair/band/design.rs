@@ -87,10 +87,14 @@ impl SplineMap {
         acc: &[[f64; 4]; 4],
         add: &mut impl FnMut(usize, usize, f64),
     ) {
-        for (k, row) in acc.iter().enumerate() {
-            let r0 = ((f + k) % self.vars) * D;
-            for (l, v) in row.iter().enumerate() {
-                let c0 = ((f + l) % self.vars) * D;
+        // The span's control points, taken modulo the count once (not once per entry).
+        let at: [usize; 4] = if f + 4 <= self.vars {
+            std::array::from_fn(|k| (f + k) * D)
+        } else {
+            std::array::from_fn(|k| ((f + k) % self.vars) * D)
+        };
+        for (row, &r0) in acc.iter().zip(&at) {
+            for (v, &c0) in row.iter().zip(&at) {
                 if r0 >= c0 {
                     for a in 0..D {
                         add(r0 + a, c0 + a, *v);

@@ -305,6 +305,17 @@ impl<const D: usize> Energy<D> {
     #[inline]
     fn delta(&self, w: &Window<D>, x: &[f64]) -> [f64; D] {
         let mut d = [0.0; D];
+        if w.first + 4 <= self.n {
+            // No wrap: the window's points are one slice (no index taken modulo n, whose
+            // integer division was most of a dense run's products with `A`).
+            let x = &x[w.first * D..(w.first + 4) * D];
+            for (k, c) in w.coef.iter().enumerate() {
+                for a in 0..D {
+                    d[a] += c * x[k * D + a];
+                }
+            }
+            return d;
+        }
         for (k, c) in w.coef.iter().enumerate() {
             let i = (w.first + k) % self.n;
             for a in 0..D {
@@ -341,6 +352,15 @@ impl<const D: usize> Energy<D> {
                     md[a] += w.metric[a][b] * d[b];
                 }
             }
+            if w.first + 4 <= self.n {
+                let out = &mut out[w.first * D..(w.first + 4) * D];
+                for (k, c) in w.coef.iter().enumerate() {
+                    for a in 0..D {
+                        out[k * D + a] += c * md[a];
+                    }
+                }
+                continue;
+            }
             for (k, c) in w.coef.iter().enumerate() {
                 let i = (w.first + k) % self.n;
                 for a in 0..D {
@@ -355,10 +375,14 @@ impl<const D: usize> Energy<D> {
     /// index first as well. Entries at the same position are reported once per window.
     pub(super) fn for_each_lower(&self, scale: f64, mut add: impl FnMut(usize, usize, f64)) {
         for w in &self.windows {
-            for k in 0..4 {
-                let i = (w.first + k) % self.n;
-                for l in 0..4 {
-                    let j = (w.first + l) % self.n;
+            // The window's points, taken modulo n once (not once per entry).
+            let at: [usize; 4] = if w.first + 4 <= self.n {
+                std::array::from_fn(|k| w.first + k)
+            } else {
+                std::array::from_fn(|k| (w.first + k) % self.n)
+            };
+            for (k, &i) in at.iter().enumerate() {
+                for (l, &j) in at.iter().enumerate() {
                     let cc = scale * w.coef[k] * w.coef[l];
                     for a in 0..D {
                         for b in 0..D {
