@@ -760,6 +760,7 @@ def noisy_case(task):
         if report is not None:
             row["noise_sigma_report"] = report.get("noise_sigma")
             row["tol_source"] = report.get("tolerance_source")
+            row["iterations"] = report.get("iterations")
         if pts is None:
             rows.append(row)
             return None
