@@ -5,6 +5,7 @@ mod band_inverse;
 mod band_lu;
 mod banded;
 mod banded_split;
+mod bracket;
 mod cyclic_banded;
 mod minimize;
 mod nelder_mead;
@@ -17,6 +18,9 @@ use std::ops::{Add, Mul, Sub};
 pub use band_inverse::factorize_with_inverse_band;
 pub use band_lu::BandLu;
 pub use banded::SymBanded;
+pub(crate) use bracket::Bracket;
+#[cfg(test)]
+pub(crate) use bracket::SLACK as BRACKET_SLACK;
 pub use cyclic_banded::CyclicSymBanded;
 pub use minimize::{Minimum, minimize_brent, minimize_golden};
 pub use nelder_mead::{NelderMeadParams, SimplexMinimum, minimize_nelder_mead};

@@ -13,7 +13,7 @@
 //! minimiser has a mean squared residual no larger than that of the noise,
 //! `(1/n) Σ |q_i − p_i|² ≤ d·(τ σ̂)²` in `d` dimensions (`τ` the parameter `fit`, slightly above 1,
 //! errs towards the smoother side). The residual shrinks and the energy grows as `μ` grows,
-//! so a bisection on `log μ` finds it, each step one banded solve, O(n). Where `σ̂`
+//! so a bracketing search on `log μ` finds it, each step one banded solve, O(n). Where `σ̂`
 //! underestimates the noise the target cannot be met; the energy is then capped at
 //! [`ENERGY_CAP`] times the passes' optimum, so the stage never returns to the noise.
 //! Where one `μ` still flattens a feature, [`Penalized::local_weights`] raises it there, from
@@ -23,7 +23,7 @@
 use super::design::{Design, SplineMap};
 use super::energy::Energy;
 use crate::error::Result;
-use crate::numeric::{CyclicSymBanded, PARALLEL_FROM, SymBanded, map_indices};
+use crate::numeric::{Bracket, CyclicSymBanded, PARALLEL_FROM, SymBanded, map_indices};
 use rayon::prelude::*;
 
 /// Points a task of [`Windows::significant`] scans.
@@ -40,9 +40,10 @@ const LOCAL_FACTOR: f64 = 4.0;
 /// this many of its smoothing lengths (see [`smooth_log_weights`]).
 const WEIGHT_SMOOTHING: f64 = 3.0;
 
-/// Bisection steps on `log μ` (the bracket spans 6·ln(2n) in `ln μ`, under 90 for 10⁶ points; 24 halvings
-/// leave `μ` within 1e-5 of itself, far below what the residual sees).
-const BISECTIONS: usize = 24;
+/// The precision of the search for `μ`, as the bisection steps on `log μ` that would reach it
+/// (the bracket spans 6·ln(2n) in `ln μ`, under 90 for 10⁶ points; 24 halvings leave `μ`
+/// within 1e-5 of itself, far below what the residual sees).
+const BISECTIONS: u32 = 24;
 
 /// The matrix `2A` with the held unknowns' rows and columns replaced by the identity, before
 /// the data weight is added.
@@ -76,7 +77,7 @@ impl Base {
 
 /// The penalised problem, in the solver's units (see `solver.rs`): `y` relative to the
 /// reference `s`, ball centres `c`, points `B y`. Everything that does not depend on `μ` is
-/// assembled once by [`Penalized::new`]; each `μ` of the bisection then costs one copy, the
+/// assembled once by [`Penalized::new`]; each `μ` of the search then costs one copy, the
 /// data term (a diagonal in the point form, the Gram matrix `BᵀB` times `μ` in the spline
 /// form) and one banded factorisation.
 pub(super) struct Penalized<'a, const D: usize> {
@@ -388,20 +389,28 @@ impl<'a, const D: usize> Penalized<'a, D> {
         // from twice the curve down to a single point, and no lower than rounding of `2A`
         // leaves meaningful.
         let unit = self.unit;
-        let (mut lo, mut hi) = (
+        let (lo, hi) = (
             (unit * (2.0 * n).powi(-6)).max(1e-15 * self.top).ln(),
             unit.ln(),
         );
 
         // A weight so small that rounding makes the matrix singular (the energy's null space,
         // quadratics in the parameter, rests on `μ` alone) asks for more weight too. `None`:
-        // the minimiser's energy reaches the cap.
-        let more_data = |ln_mu: f64| match self.minimiser(|_| ln_mu.exp(), true) {
-            Ok(y) => (self.energy_at(&y, anchor_energy) < cap)
-                .then(|| self.mean_square_residual(&y) > target),
-            Err(_) => Some(true),
+        // the minimiser's energy reaches the cap. With the verdict, `g = ln(residual/target)`
+        // (NaN where unknown), which the search interpolates.
+        let verdict = |ln_mu: f64| match self.minimiser(|_| ln_mu.exp(), true) {
+            Ok(y) => {
+                if self.energy_at(&y, anchor_energy) < cap {
+                    let g = (self.mean_square_residual(&y) / target).ln();
+                    (Some(g > 0.0), g)
+                } else {
+                    (None, f64::NAN)
+                }
+            }
+            Err(_) => (Some(true), f64::NAN),
         };
-        match more_data(lo) {
+        let (more, g_lo) = verdict(lo);
+        match more {
             None => return Ok(None),
             // The smoothest weight that rounding leaves meaningful meets the target already:
             // the reference, held by the band at a few points, is farther from the data than
@@ -410,15 +419,20 @@ impl<'a, const D: usize> Penalized<'a, D> {
             Some(false) => return Ok(Some(lo.exp())),
             Some(true) => {}
         }
-        for _ in 0..BISECTIONS {
-            let mid = 0.5 * (lo + hi);
-            if more_data(mid) == Some(true) {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
+        // The smallest `μ` that meets the target, to the bracket a bisection of
+        // [`BISECTIONS`] steps would leave, by the root finder `mst` searches its `p` with
+        // (Chandrupatla's interpolation inside a bracket that only the verdicts move), in
+        // `x = −ln μ` so that its feasible end is the lower one. `g` is smooth and monotone
+        // here, and 7–10 minimisers replace the bisection's 24.
+        let (_, g_hi) = verdict(hi);
+        let precision = (hi - lo) / f64::from(1u32 << BISECTIONS);
+        let mut bracket = Bracket::new(-hi, g_hi, -lo, g_lo, precision);
+        while !bracket.converged() {
+            let x = bracket.next();
+            let (more, g) = verdict(-x);
+            bracket.update(x, more != Some(true), g);
         }
-        Ok(Some(hi.exp()))
+        Ok(Some((-bracket.lo()).exp()))
     }
 
     /// Raise the data weight where the residual is biased: starting from `μ` everywhere,
@@ -576,7 +590,7 @@ impl<T: Copy> RunCache<T> {
 
 /// One knot span's share of `Σ_i |(B y)_i − c_i|²` over the free points on it, as a
 /// quadratic in its four control points: `Σ_kl G_kl y_k·y_l − 2 Σ_k y_k·H_k + γ`. With them
-/// the discrepancy's bisection measures a residual in O(control points), not O(points).
+/// the discrepancy's search measures a residual in O(control points), not O(points).
 #[derive(Clone, Debug)]
 struct SpanSums<const D: usize> {
     first: usize,
@@ -817,6 +831,67 @@ impl Marks {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fair::band::energy::Metric;
+
+    /// The discrepancy weight is the smallest `μ` whose minimiser meets the target, to the
+    /// precision of the bisection it replaced: its minimiser meets the target, and one
+    /// precision below it does not; the same `μ` as a 24-step bisection, within that
+    /// precision. A noisy wave in the point form, at targets across the bracket.
+    #[test]
+    fn the_discrepancy_weight_is_the_bisections() {
+        let n = 200;
+        let pts: Vec<[f64; 2]> = (0..n)
+            .map(|i| {
+                let x = i as f64 * 0.05;
+                // A deterministic ripple as the noise.
+                [x, x.sin() + 0.03 * (7.3 * i as f64).sin()]
+            })
+            .collect();
+        let energy = Energy::build(&pts, false, Metric::Jerk);
+        let design = Design::Points { n };
+        let (held, pinned) = (vec![false; n], vec![false; n]);
+        let zeros = vec![0.0; 2 * n];
+        let centres: Vec<f64> = pts.iter().flatten().copied().collect();
+        let fit = Penalized::new(
+            &energy, 1.0, &design, &held, &pinned, &zeros, &zeros, &centres,
+        );
+        let msr = |ln_mu: f64| {
+            let y = fit.minimiser(|_| ln_mu.exp(), true).unwrap();
+            fit.mean_square_residual(&y)
+        };
+        let (lo, hi) = ((2.0 * n as f64).powi(-6).max(1e-15 * fit.top).ln(), 0.0);
+        let precision = (hi - lo) / f64::from(1u32 << BISECTIONS);
+        for fraction in [0.05, 0.3, 0.6, 0.9] {
+            // A target between the residuals at the two ends of the bracket.
+            let target = msr(hi) + fraction * (msr(lo) - msr(hi));
+            let mu = fit
+                .discrepancy_weight(0.0, target, f64::INFINITY)
+                .unwrap()
+                .unwrap();
+            assert!(
+                msr(mu.ln()) <= target,
+                "{fraction}: μ {mu} misses the target"
+            );
+            assert!(
+                msr(mu.ln() - precision) > target,
+                "{fraction}: μ {mu} not the smallest"
+            );
+            let (mut a, mut b) = (lo, hi);
+            for _ in 0..BISECTIONS {
+                let mid = 0.5 * (a + b);
+                if msr(mid) > target {
+                    a = mid;
+                } else {
+                    b = mid;
+                }
+            }
+            assert!(
+                (mu.ln() - b).abs() <= precision,
+                "{fraction}: {mu} against {}",
+                b.exp()
+            );
+        }
+    }
 
     /// Equal weights stay equal; a step of the weights becomes a monotone ramp between its two
     /// levels, as wide as the windows (3 smoothing lengths of each side's weight), open and

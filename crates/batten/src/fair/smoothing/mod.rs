@@ -76,7 +76,6 @@
 //! [`CyclicSymBanded`]: crate::numeric::CyclicSymBanded
 //! [`minimize_brent`]: crate::numeric::minimize_brent
 
-mod bracket;
 mod mst;
 mod problem;
 mod search;

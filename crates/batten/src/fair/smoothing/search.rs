@@ -1,12 +1,12 @@
 //! The choice of p: the smoothest spline within a tolerance ([`Bracket`]), or minimal GCV.
 
-use super::bracket::Bracket;
 use super::{
     BISECTION_REL_PRECISION, Fit, GCV_LOG_ALPHA_TOL, GCV_MAX_EVALUATIONS, GCV_SCAN_STEP,
     LOG_ALPHA_ABOVE, LOG_ALPHA_BELOW, Problem, SmoothingInfo, SmoothingTrial, max_displacement,
     roughness,
 };
 use crate::error::{Error, Result};
+use crate::numeric::Bracket;
 use crate::numeric::minimize_brent;
 
 impl<'a, const D: usize> Problem<'a, D> {
@@ -222,8 +222,9 @@ impl<'a, const D: usize> Problem<'a, D> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{DEFAULT_MAX_SEARCH_STEPS, bracket::SLACK};
+    use super::super::DEFAULT_MAX_SEARCH_STEPS;
     use super::*;
+    use crate::numeric::BRACKET_SLACK as SLACK;
     use crate::test_rng::Rng;
     use proptest::prelude::*;
 

@@ -1,4 +1,6 @@
-//! The root finder of tolerance mode: where to fit next, given what the fits so far said.
+//! A bracketing root finder for a monotone verdict: where to evaluate next, given what the
+//! evaluations so far said. It serves `mst`'s tolerance mode (below, in its terms) and
+//! `band`'s discrepancy weight (`fair/band/debias.rs`).
 //!
 //! The search looks for the largest `λ = ln(α/α_ref)` whose fit is feasible (largest
 //! displacement `d(λ) ≤ tol`), to a bracket `[lo, hi]` — `lo` feasible, `hi` infeasible or the
@@ -7,7 +9,7 @@
 //! (`d ∝ α` there) and flattens towards the line's displacement at the top, but between the
 //! two it has plateaus (the noise smoothed away, the signal not yet) and kinks (another point
 //! takes the largest displacement), so no one model of it holds (see "Choosing p" in
-//! [`super`]).
+//! `fair/smoothing/mod.rs`).
 //!
 //! Chandrupatla's method (1997): inverse quadratic interpolation through the two ends of the
 //! bracket and the point last dropped when the data say that the inverse quadratic is
@@ -47,11 +49,11 @@ const EXTRAPOLATE: f64 = 0.02;
 /// fit more on average; with none, the bisection's count is the typical one). On the test
 /// curves of up to 200 points the search never takes more fits than the bisection
 /// (`fair/smoothing/search.rs`).
-pub(super) const SLACK: i32 = 3;
+pub(crate) const SLACK: i32 = 3;
 
 /// The state of the search: Chandrupatla's three points and the step budget.
 #[derive(Clone, Debug)]
-pub(super) struct Bracket {
+pub(crate) struct Bracket {
     /// The newest end of the bracket, `g` there, and whether its fit is feasible.
     x1: f64,
     f1: f64,
@@ -82,7 +84,7 @@ impl Bracket {
     /// The bracket `[lo, hi]` with `lo` feasible and `hi` infeasible or the end of the range,
     /// and `g` at both (NaN where unknown: a failed fit). The first step is the slope-1 guess
     /// from `lo`, or the midpoint when `g(lo)` is not finite (a zero displacement).
-    pub(super) fn new(lo: f64, g_lo: f64, hi: f64, g_hi: f64, precision: f64) -> Bracket {
+    pub(crate) fn new(lo: f64, g_lo: f64, hi: f64, g_hi: f64, precision: f64) -> Bracket {
         let eps = 0.5 * precision * (1.0 - 1e-9);
         let halvings = ((hi - lo) / (2.0 * eps)).log2().ceil().max(0.0);
         let t = -g_lo / (hi - lo);
@@ -104,27 +106,27 @@ impl Bracket {
     }
 
     /// The feasible end.
-    pub(super) fn lo(&self) -> f64 {
+    pub(crate) fn lo(&self) -> f64 {
         if self.feasible1 { self.x1 } else { self.x2 }
     }
 
     /// The infeasible end (or the end of the range).
-    pub(super) fn hi(&self) -> f64 {
+    pub(crate) fn hi(&self) -> f64 {
         if self.feasible1 { self.x2 } else { self.x1 }
     }
 
     /// `hi − lo`.
-    pub(super) fn width(&self) -> f64 {
+    pub(crate) fn width(&self) -> f64 {
         self.hi() - self.lo()
     }
 
     /// Whether the bracket is at most the precision wide.
-    pub(super) fn converged(&self) -> bool {
+    pub(crate) fn converged(&self) -> bool {
         self.width() <= self.precision
     }
 
     /// Where to fit next: strictly inside the bracket.
-    pub(super) fn next(&self) -> f64 {
+    pub(crate) fn next(&self) -> f64 {
         let (lo, hi) = (self.lo(), self.hi());
         let w = hi - lo;
         let mid = lo + 0.5 * w;
@@ -142,7 +144,7 @@ impl Bracket {
 
     /// Take the verdict of the fit at `x` (from [`Bracket::next`]): whether it is feasible,
     /// and `g` there (NaN when unknown).
-    pub(super) fn update(&mut self, x: f64, feasible: bool, g: f64) {
+    pub(crate) fn update(&mut self, x: f64, feasible: bool, g: f64) {
         self.same_end = feasible == self.feasible1;
         if self.same_end {
             (self.x3, self.f3) = (self.x1, self.f1);
