@@ -399,7 +399,10 @@ impl Design {
             Design::Spline(s) => {
                 // Each knot span's sum over its points, in point order, in pieces that start
                 // where a span does (in parallel on long curves), then reported span by span
-                // in order: the same sums and the same calls as one sweep.
+                // in order: the same sums and the same calls as one sweep. A span that does
+                // not wrap reports only its entries with `k ≥ l` (its control points
+                // increase), so only those are summed.
+                let lower_only = |f: usize| f + 4 <= s.vars;
                 let piece = |from: usize, to: usize| -> Vec<(usize, [[f64; 4]; 4])> {
                     let mut out: Vec<(usize, [[f64; 4]; 4])> = Vec::new();
                     for i in from..to {
@@ -414,28 +417,32 @@ impl Design {
                             continue;
                         };
                         let w = weight(i);
-                        for k in 0..4 {
-                            let wb = w * b[k];
-                            for l in 0..4 {
-                                acc[k][l] += wb * b[l];
+                        if lower_only(f) {
+                            for k in 0..4 {
+                                let wb = w * b[k];
+                                for l in 0..=k {
+                                    acc[k][l] += wb * b[l];
+                                }
+                            }
+                        } else {
+                            for k in 0..4 {
+                                let wb = w * b[k];
+                                for l in 0..4 {
+                                    acc[k][l] += wb * b[l];
+                                }
                             }
                         }
                     }
                     out
                 };
                 let n = s.first.len();
-                let runs: Vec<(usize, [[f64; 4]; 4])> = if n >= PARALLEL_FROM {
+                let pieces: Vec<Vec<(usize, [[f64; 4]; 4])>> = if n >= PARALLEL_FROM {
                     let cuts = s.span_cuts(EVAL_CHUNK);
-                    cuts.par_windows(2)
-                        .map(|c| piece(c[0], c[1]))
-                        .collect::<Vec<_>>()
-                        .into_iter()
-                        .flatten()
-                        .collect()
+                    cuts.par_windows(2).map(|c| piece(c[0], c[1])).collect()
                 } else {
-                    piece(0, n)
+                    vec![piece(0, n)]
                 };
-                for (f, acc) in &runs {
+                for (f, acc) in pieces.iter().flatten() {
                     s.add_span_lower::<D>(*f, acc, &mut add);
                 }
             }
