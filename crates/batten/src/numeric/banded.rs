@@ -151,6 +151,35 @@ impl SymBanded {
         self.split = None;
     }
 
+    /// `out += scale · A x` for the (unfactorised) symmetric matrix: each stored entry of the
+    /// lower band read once and applied to both its row and its column.
+    ///
+    /// # Panics
+    /// After factorisation, or if the lengths are not `n`.
+    pub(crate) fn mul_add(&self, x: &[f64], scale: f64, out: &mut [f64]) {
+        assert!(!self.factored, "SymBanded::mul_add after factorisation");
+        assert!(
+            x.len() == self.n && out.len() == self.n,
+            "SymBanded::mul_add lengths"
+        );
+        match self.bw {
+            7 => mul_add_fixed::<7>(&self.band, x, scale, out),
+            11 => mul_add_fixed::<11>(&self.band, x, scale, out),
+            bw => {
+                let w = bw + 1;
+                for (i, row) in self.band.chunks_exact(w).enumerate() {
+                    let xi = scale * x[i];
+                    let mut acc = row[0] * xi;
+                    for k in 1..=bw.min(i) {
+                        acc += row[k] * scale * x[i - k];
+                        out[i - k] += row[k] * xi;
+                    }
+                    out[i] += acc;
+                }
+            }
+        }
+    }
+
     /// Factorise as `L D Lᵀ` with static regularisation, for the positive semidefinite
     /// systems of interior-point methods: a pivot below `delta` (absolute) is replaced by
     /// `delta`, and the count of such pivots returned. The solve is then that of a nearby
@@ -217,6 +246,33 @@ impl SymBanded {
             }
         }
         Ok(())
+    }
+}
+
+/// [`SymBanded::mul_add`] with the half-bandwidth fixed at compile time (loops of fixed
+/// length past the first `BW` rows).
+fn mul_add_fixed<const BW: usize>(band: &[f64], x: &[f64], scale: f64, out: &mut [f64]) {
+    let w = BW + 1;
+    for (i, row) in band.chunks_exact(w).enumerate() {
+        let xi = scale * x[i];
+        let mut acc = row[0] * xi;
+        if i >= BW {
+            let row: &[f64; BW] = row[1..].try_into().unwrap_or(&[0.0; BW]);
+            let xs = &x[i - BW..i];
+            let os = &mut out[i - BW..i];
+            for k in 0..BW {
+                // Entry (i, i − 1 − k) of the row, stored at offset k + 1.
+                let j = BW - 1 - k;
+                acc += row[k] * scale * xs[j];
+                os[j] += row[k] * xi;
+            }
+        } else {
+            for k in 1..=i {
+                acc += row[k] * scale * x[i - k];
+                out[i - k] += row[k] * xi;
+            }
+        }
+        out[i] += acc;
     }
 }
 
@@ -434,6 +490,30 @@ pub(super) fn test_matrix(n: usize, bw: usize, weak_every: Option<usize>) -> Sym
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The product with the symmetric band matches the dense one entry by entry, for the
+    /// fixed half-bandwidths and a general one, short matrices included; `scale` multiplies.
+    #[test]
+    fn mul_add_is_the_symmetric_product() {
+        for (n, bw) in [(40, 7), (5, 7), (60, 11), (9, 11), (30, 3), (2, 3)] {
+            let a = test_matrix(n, bw, None);
+            let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).sin() + 0.5).collect();
+            let mut got: Vec<f64> = (0..n).map(|i| i as f64).collect();
+            a.mul_add(&x, 0.5, &mut got);
+            for i in 0..n {
+                let row: f64 = (0..n)
+                    .filter(|&j| i.abs_diff(j) <= bw)
+                    .map(|j| a.get(i, j) * x[j])
+                    .sum();
+                let want = i as f64 + 0.5 * row;
+                assert!(
+                    (got[i] - want).abs() <= 1e-14 * (1.0 + want.abs()),
+                    "n {n} bw {bw} row {i}: {} against {want}",
+                    got[i]
+                );
+            }
+        }
+    }
 
     impl SymBanded {
         /// The general loops of [`SymBanded::solve_in_place`], whatever the bandwidth.

@@ -151,6 +151,8 @@ enum Newton {
         base: SymBanded,
         work: SymBanded,
         exact: bool,
+        /// No unknown is held: `base` is `2A` itself.
+        plain: bool,
     },
     Closed {
         work: Option<CyclicSymBanded>,
@@ -181,6 +183,19 @@ impl Newton {
             base,
             work,
             exact: false,
+            plain: !held.iter().any(|h| *h),
+        }
+    }
+
+    /// `out += A x`: from the assembled band `2A` when it is the energy's own (open, nothing
+    /// held), which reads 8 numbers a row where the energy's windows (three to seven a knot
+    /// span in the spline form) read 9 each; from the windows otherwise.
+    fn energy_apply_add<const D: usize>(&self, energy: &Energy<D>, x: &[f64], out: &mut [f64]) {
+        match self {
+            Newton::Open {
+                base, plain: true, ..
+            } => base.mul_add(x, 0.5, out),
+            _ => energy.apply_add(x, out),
         }
     }
 
@@ -192,7 +207,9 @@ impl Newton {
     ) -> Result<()> {
         let (energy, held) = (p.energy, p.held);
         match self {
-            Newton::Open { base, work, exact } => {
+            Newton::Open {
+                base, work, exact, ..
+            } => {
                 work.assign(base);
                 let mut top = 0.0_f64;
                 match p.design {
@@ -629,7 +646,7 @@ impl<'p, 'a, const D: usize> Ipm<'p, 'a, D> {
         let (held, pinned) = (p.held, p.pinned);
         let st = &mut self.st;
         self.ay.fill(0.0);
-        p.energy.apply_add(&st.y, &mut self.ay);
+        self.newton.energy_apply_add(p.energy, &st.y, &mut self.ay);
         for k in 0..dim {
             self.grad[k] = 2.0 * (self.ay[k] + p.anchor[k]);
         }
