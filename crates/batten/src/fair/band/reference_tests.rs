@@ -417,7 +417,10 @@ fn check_spline(n: usize, closed: bool, metric: Metric, spans: usize, hold_ends:
 
 /// With the debiasing stage's data term (uneven weights), the working set gives the optimum
 /// of the solve over every point, and of the same problem: objectives within 1e-9, points
-/// within 1e-6 tolerances.
+/// within 1e-5 tolerances. (The two runs take different paths, and a round the working set
+/// ends early takes yet another: along the optimum's flattest directions a relative gap of
+/// 1e-9 fixes the points only to about its square root. The closed case's points were
+/// 1.5e-6 apart once rounds could end early, 1e-6 before.)
 #[test]
 fn working_set_matches_the_solve_over_every_point() {
     for (closed, hold_ends) in [(false, false), (false, true), (true, false)] {
@@ -443,7 +446,7 @@ fn working_set_matches_the_solve_over_every_point() {
             ws.r.iter()
                 .zip(&all.r)
                 .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
-        assert!(apart < 1e-6, "closed {closed}: points {apart} apart");
+        assert!(apart < 1e-5, "closed {closed}: points {apart} apart");
         assert!(ws.r.chunks(2).all(|r| r[0] * r[0] + r[1] * r[1] <= 1.0));
     }
 }
@@ -462,4 +465,32 @@ fn spline_form_matches_clarabel() {
         true,
     );
     check_spline(1600, true, Metric::Jerk, 48, false);
+}
+
+/// The round's check is asked once, when the gap falls below its threshold, and a `true`
+/// ends the run there, short of the stopping rule; `false` leaves the run as it was.
+#[test]
+fn the_rounds_check_is_asked_once_and_ends_the_run() {
+    let case = SplineCase::new(1500, false, Metric::Jerk, 40, false);
+    let problem = case.problem();
+    let plain = super::solver::solve_all(&problem).expect("solve");
+    let mut asked = 0;
+    let on = super::solver::solve_all_checked(&problem, |_| {
+        asked += 1;
+        false
+    })
+    .expect("solve");
+    assert_eq!(asked, 1);
+    assert_eq!(on.iterations, plain.iterations);
+    assert_eq!(on.objective.to_bits(), plain.objective.to_bits());
+    let stopped = super::solver::solve_all_checked(&problem, |_| true).expect("solve");
+    assert!(plain.converged && !stopped.converged);
+    assert!(stopped.iterations < plain.iterations);
+    assert!(stopped.gap <= 1e-2 && stopped.gap > super::solver::GAP_REL);
+    assert!(
+        stopped
+            .r
+            .chunks(2)
+            .all(|r| r[0] * r[0] + r[1] * r[1] <= 1.0)
+    );
 }

@@ -419,6 +419,19 @@ pub(super) fn solve<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
 /// # Errors
 /// As [`solve`].
 pub(super) fn solve_all<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> {
+    solve_all_checked(p, |_| false)
+}
+
+/// The relative gap at which [`solve_all_checked`] asks whether to go on.
+const CHECK_GAP_REL: f64 = 1e-2;
+
+/// [`solve_all`], asking `stop(y)` once, when the relative gap first falls below
+/// [`CHECK_GAP_REL`], whether the run should end there (not converged) instead.
+pub(super) fn solve_all_checked<const D: usize>(
+    p: &Problem<'_, D>,
+    mut stop: impl FnMut(&[f64]) -> bool,
+) -> Result<Solution> {
+    let mut checked = false;
     let mut ipm = Ipm::start(p)?;
     let free = ipm.free;
     let mut iterations = 0;
@@ -436,6 +449,12 @@ pub(super) fn solve_all<const D: usize>(p: &Problem<'_, D>) -> Result<Solution> 
         } = ipm.residuals();
         last_gap = gap / scale;
         let gap_ok = gap <= p.gap_rel * scale;
+        if !checked && !gap_ok && gap <= CHECK_GAP_REL * scale {
+            checked = true;
+            if stop(&ipm.st.y) {
+                break;
+            }
+        }
         if gap_ok && dual_ratio <= 1.0 {
             converged = true;
             break;

@@ -16,7 +16,11 @@
 //! 3. The interior point solves the problem on `S`. When a point outside `S` is outside its
 //!    ball, every point outside `S` farther than [`ADD`] from its input point joins `S`, and
 //!    the next round starts on the segment from the strictly feasible start to the last
-//!    solution, as far along as keeps the new points strictly inside.
+//!    solution, as far along as keeps the new points strictly inside. The points outside `S`
+//!    are first checked when the round's relative gap falls below 1e-2 (one sweep over the
+//!    points): if one is outside its ball already, the round ends there, since its last
+//!    iterations would only refine a solution the next round replaces (dense quality splits:
+//!    10 856 → 10 318 and 10 905 → 10 313 iterations, the same results; #14's sine 100 → 89).
 //!
 //! When no point is outside its ball the working set's optimum is the full problem's (it
 //! minimises over a larger set and is feasible), with multipliers zero at the points outside
@@ -25,7 +29,7 @@
 
 use super::design::{Design, SplineMap};
 use super::energy::{Energy, Window};
-use super::solver::{Problem, Solution, solve_all};
+use super::solver::{Problem, Solution, solve_all, solve_all_checked};
 use crate::error::Result;
 
 /// Points farther than this from the reference (in tolerances) start in the working set.
@@ -86,7 +90,14 @@ pub(super) fn solve<const D: usize>(
             gap_rel: p.gap_rel,
             fidelity: Vec::new(),
         };
-        let sol = solve_all(&sub)?;
+        // Once the round is well on its way, a point outside the set already outside its ball
+        // ends it there: its last iterations would only refine a solution the next round
+        // replaces.
+        let sol = solve_all_checked(&sub, |y| {
+            p.design
+                .residual::<D>(y, &p.centres, Some(p.pinned), &mut r);
+            (0..n).any(|i| !in_set[i] && norm2(&r[i * D..(i + 1) * D]) > 1.0)
+        })?;
         iterations += sol.iterations;
         p.design
             .residual::<D>(&sol.y, &p.centres, Some(p.pinned), &mut r);
