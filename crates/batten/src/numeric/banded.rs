@@ -61,15 +61,6 @@ impl SymBanded {
         self.band[i * (self.bw + 1) + (i - j)] += v;
     }
 
-    /// Add `v` to `A[i][j]` for `j ≤ i ≤ j + bw` (the lower band), for assembly loops that
-    /// know their indices are in the band: [`SymBanded::add`] without its checks (debug
-    /// builds keep them).
-    #[inline]
-    pub(crate) fn add_lower(&mut self, i: usize, j: usize, v: f64) {
-        debug_assert!(!self.factored && j <= i && i - j <= self.bw);
-        self.band[i * (self.bw + 1) + (i - j)] += v;
-    }
-
     /// Factorise as `L D Lᵀ` (L unit lower triangular, banded). No pivoting: meant for
     /// symmetric positive definite matrices.
     ///
@@ -149,6 +140,45 @@ impl SymBanded {
         self.band.copy_from_slice(&other.band);
         self.factored = false;
         self.split = None;
+    }
+
+    /// The rows `from..to` of the (unfactorised) lower band, to add entries to.
+    ///
+    /// # Panics
+    /// After factorisation, or if the rows are not within the matrix.
+    pub(crate) fn rows_mut(&mut self, from: usize, to: usize) -> BandRows<'_> {
+        assert!(
+            !self.factored && from <= to && to <= self.n,
+            "SymBanded::rows_mut"
+        );
+        let w = self.bw + 1;
+        BandRows {
+            band: &mut self.band[from * w..to * w],
+            from,
+            w,
+        }
+    }
+
+    /// The rows before `row` and the rows from it on, to add entries to from two threads.
+    ///
+    /// # Panics
+    /// After factorisation, or if `row` is past the last row.
+    pub(crate) fn split_rows_mut(&mut self, row: usize) -> (BandRows<'_>, BandRows<'_>) {
+        assert!(!self.factored && row <= self.n, "SymBanded::split_rows_mut");
+        let w = self.bw + 1;
+        let (top, bottom) = self.band.split_at_mut(row * w);
+        (
+            BandRows {
+                band: top,
+                from: 0,
+                w,
+            },
+            BandRows {
+                band: bottom,
+                from: row,
+                w,
+            },
+        )
     }
 
     /// `out += scale · A x` for the (unfactorised) symmetric matrix: each stored entry of the
@@ -246,6 +276,34 @@ impl SymBanded {
             }
         }
         Ok(())
+    }
+}
+
+/// Consecutive rows of a [`SymBanded`]'s lower band ([`SymBanded::rows_mut`],
+/// [`SymBanded::split_rows_mut`]): entries are added by their matrix indices.
+#[derive(Debug)]
+pub(crate) struct BandRows<'a> {
+    band: &'a mut [f64],
+    /// The first row held.
+    from: usize,
+    /// The stored entries a row (`bw + 1`).
+    w: usize,
+}
+
+impl BandRows<'_> {
+    /// Whether row `i` is held.
+    #[inline]
+    pub(crate) fn holds(&self, i: usize) -> bool {
+        i >= self.from && (i - self.from) * self.w < self.band.len()
+    }
+
+    /// Add `v` to `A[i][j]` (`j ≤ i ≤ j + bw`); an entry of a row not held is left out.
+    #[inline]
+    pub(crate) fn add_lower(&mut self, i: usize, j: usize, v: f64) {
+        if self.holds(i) {
+            debug_assert!(j <= i && i - j < self.w);
+            self.band[(i - self.from) * self.w + (i - j)] += v;
+        }
     }
 }
 

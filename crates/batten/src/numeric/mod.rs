@@ -17,6 +17,7 @@ use std::ops::{Add, Mul, Sub};
 
 pub use band_inverse::factorize_with_inverse_band;
 pub use band_lu::BandLu;
+pub(crate) use banded::BandRows;
 pub use banded::SymBanded;
 pub(crate) use bracket::Bracket;
 #[cfg(test)]

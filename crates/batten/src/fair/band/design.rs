@@ -6,11 +6,15 @@
 //! four consecutive control points, so every matrix the solver builds keeps the band of the
 //! energy (half-bandwidth `4D − 1` in the interleaved numbering).
 
-use crate::numeric::{PARALLEL_FROM, SymBanded, map_indices};
+use crate::numeric::{BandRows, PARALLEL_FROM, SymBanded, map_indices};
 use rayon::prelude::*;
 
 /// Points a task of [`Design::eval`] evaluates.
 const EVAL_CHUNK: usize = 1 << 14;
+
+/// From this many points [`SplineMap::add_blocks_open`] assembles on two threads (the
+/// working sets of long dense curves: 28 000–53 000 points on #14's sine).
+const SPLIT_ASSEMBLY_FROM: usize = 1 << 14;
 
 /// The map from unknowns to points.
 #[derive(Clone, Debug)]
@@ -117,11 +121,46 @@ impl SplineMap {
         held: &[bool],
         m: &mut SymBanded,
     ) {
+        let n = blocks.len();
+        let cut = if n >= SPLIT_ASSEMBLY_FROM {
+            self.first[n / 2]
+        } else {
+            0
+        };
+        if cut < 4 {
+            self.add_blocks_rows::<D>(blocks, skip, held, 0..n, m.rows_mut(0, m.n()));
+            return;
+        }
+        // Two threads, each writing the rows it owns: the first the rows of control points
+        // before `cut` (from the spans before it), the second the others (from the spans
+        // from `cut − 3` on, which reach them). Every entry gets the same terms in the same
+        // order as one sweep: the same sums, bit for bit.
+        let from = |span: usize| self.first[..n].partition_point(|&f| f < span);
+        let (top, bottom) = m.split_rows_mut(cut * D);
+        rayon::join(
+            || self.add_blocks_rows::<D>(blocks, skip, held, 0..from(cut), top),
+            || self.add_blocks_rows::<D>(blocks, skip, held, from(cut - 3)..n, bottom),
+        );
+    }
+
+    /// [`SplineMap::add_blocks_open`] for the points `points`, into the rows `rows` holds
+    /// (the entries of other rows left out).
+    fn add_blocks_rows<const D: usize>(
+        &self,
+        blocks: &[[[f64; D]; D]],
+        skip: &[bool],
+        held: &[bool],
+        points: std::ops::Range<usize>,
+        mut rows: BandRows<'_>,
+    ) {
         let mut acc = [[[[0.0; D]; D]; 4]; 4];
-        let flush = |f: usize, acc: &mut [[[[f64; D]; D]; 4]; 4], m: &mut SymBanded| {
+        let flush = |f: usize, acc: &mut [[[[f64; D]; D]; 4]; 4], m: &mut BandRows<'_>| {
             let any_held = (0..4).any(|k| held[f + k]);
             for k in 0..4 {
                 let r0 = (f + k) * D;
+                if !m.holds(r0) {
+                    continue;
+                }
                 // Blocks right of the diagonal block hold no entry of the lower triangle.
                 for l in 0..=k {
                     if any_held && (held[f + k] || held[f + l]) {
@@ -140,14 +179,14 @@ impl SplineMap {
             *acc = [[[[0.0; D]; D]; 4]; 4];
         };
         let mut current = None;
-        for (i, mb) in blocks.iter().enumerate() {
+        for i in points {
             if skip[i] {
                 continue;
             }
-            let (f, b) = (self.first[i], &self.basis[i]);
+            let (f, b, mb) = (self.first[i], &self.basis[i], &blocks[i]);
             if current != Some(f) {
                 if let Some(g) = current {
-                    flush(g, &mut acc, m);
+                    flush(g, &mut acc, &mut rows);
                 }
                 current = Some(f);
             }
@@ -163,7 +202,7 @@ impl SplineMap {
             }
         }
         if let Some(g) = current {
-            flush(g, &mut acc, m);
+            flush(g, &mut acc, &mut rows);
         }
     }
 
@@ -518,6 +557,57 @@ pub(super) mod tests {
         for held_ends in [false, true] {
             let held: Vec<bool> = (0..map.vars)
                 .map(|j| held_ends && (j == 0 || j == map.vars - 1))
+                .collect();
+            let mut want = SymBanded::zeros(dim, 7);
+            design.for_each_block_lower::<2>(&blocks, &skip, |r, c, v| {
+                if !held[r / 2] && !held[c / 2] {
+                    want.add(r, c, v);
+                }
+            });
+            let mut got = SymBanded::zeros(dim, 7);
+            map.add_blocks_open::<2>(&blocks, &skip, &held, &mut got);
+            for r in 0..dim {
+                for c in r.saturating_sub(7)..=r {
+                    assert_eq!(got.get(r, c).to_bits(), want.get(r, c).to_bits(), "{r} {c}");
+                }
+            }
+        }
+    }
+
+    /// On a long curve (two threads, each on its own rows) the blocks written into the band
+    /// are the callback's entries, bit for bit, held ends left out.
+    #[test]
+    fn blocks_into_the_band_on_two_threads_match_the_callback() {
+        let n = SPLIT_ASSEMBLY_FROM + 3001;
+        let spans = 2000;
+        let vars = spans + 3;
+        let first: Vec<usize> = (0..n)
+            .map(|i| {
+                let u = i as f64 / n as f64;
+                let v = u + 0.1 * (std::f64::consts::TAU * u).sin() / std::f64::consts::TAU;
+                ((v * spans as f64) as usize).min(spans - 1)
+            })
+            .collect();
+        let basis: Vec<[f64; 4]> = (0..n)
+            .map(|i| {
+                let u = (i as f64 * 0.37).fract();
+                [(1.0 - u) / 3.0, 0.4, u / 3.0, 0.1 + 0.01 * u]
+            })
+            .collect();
+        let map = SplineMap { vars, first, basis };
+        let design = Design::Spline(map.clone());
+        let blocks: Vec<[[f64; 2]; 2]> = (0..n)
+            .map(|i| {
+                let a = 1.0 + (i as f64 * 0.3).sin().abs();
+                let b = 0.2 * (i as f64 * 0.9).cos();
+                [[a, b], [b, 0.5 * a + 0.1]]
+            })
+            .collect();
+        let skip: Vec<bool> = (0..n).map(|i| i % 7 == 3).collect();
+        let dim = 2 * vars;
+        for held_ends in [false, true] {
+            let held: Vec<bool> = (0..vars)
+                .map(|j| held_ends && (j < 2 || j + 2 >= vars))
                 .collect();
             let mut want = SymBanded::zeros(dim, 7);
             design.for_each_block_lower::<2>(&blocks, &skip, |r, c, v| {
