@@ -543,9 +543,36 @@ pub(super) mod tests {
     #[test]
     fn blocks_into_the_band_match_the_callback() {
         let map = map(false);
+        let n = map.first.len();
+        assert_blocks_match(&map, &(0..n).map(|i| i % 4 == 3).collect::<Vec<_>>(), 1);
+    }
+
+    /// A long open spline map (more points near the middle of the spans), as the long curves
+    /// of the tests below.
+    fn long_map(n: usize, spans: usize) -> SplineMap {
+        let vars = spans + 3;
+        let first: Vec<usize> = (0..n)
+            .map(|i| {
+                let u = i as f64 / n as f64;
+                let v = u + 0.1 * (std::f64::consts::TAU * u).sin() / std::f64::consts::TAU;
+                ((v * spans as f64) as usize).min(spans - 1)
+            })
+            .collect();
+        let basis: Vec<[f64; 4]> = (0..n)
+            .map(|i| {
+                let u = (i as f64 * 0.37).fract();
+                [(1.0 - u) / 3.0, 0.4, u / 3.0, 0.1 + 0.01 * u]
+            })
+            .collect();
+        SplineMap { vars, first, basis }
+    }
+
+    /// [`SplineMap::add_blocks_open`] on `map` (points `skip` left out) writes the entries
+    /// [`Design::for_each_block_lower`] reports, bit for bit, with nothing held and with
+    /// `ends` control points held at each end.
+    fn assert_blocks_match(map: &SplineMap, skip: &[bool], ends: usize) {
         let design = Design::Spline(map.clone());
-        let n = design.points();
-        let dim = 2 * map.vars;
+        let (n, vars) = (map.first.len(), map.vars);
         let blocks: Vec<[[f64; 2]; 2]> = (0..n)
             .map(|i| {
                 let a = 1.0 + (i as f64 * 0.3).sin().abs();
@@ -553,19 +580,19 @@ pub(super) mod tests {
                 [[a, b], [b, 0.5 * a + 0.1]]
             })
             .collect();
-        let skip: Vec<bool> = (0..n).map(|i| i % 4 == 3).collect();
+        let dim = 2 * vars;
         for held_ends in [false, true] {
-            let held: Vec<bool> = (0..map.vars)
-                .map(|j| held_ends && (j == 0 || j == map.vars - 1))
+            let held: Vec<bool> = (0..vars)
+                .map(|j| held_ends && (j < ends || j + ends >= vars))
                 .collect();
             let mut want = SymBanded::zeros(dim, 7);
-            design.for_each_block_lower::<2>(&blocks, &skip, |r, c, v| {
+            design.for_each_block_lower::<2>(&blocks, skip, |r, c, v| {
                 if !held[r / 2] && !held[c / 2] {
                     want.add(r, c, v);
                 }
             });
             let mut got = SymBanded::zeros(dim, 7);
-            map.add_blocks_open::<2>(&blocks, &skip, &held, &mut got);
+            map.add_blocks_open::<2>(&blocks, skip, &held, &mut got);
             for r in 0..dim {
                 for c in r.saturating_sub(7)..=r {
                     assert_eq!(got.get(r, c).to_bits(), want.get(r, c).to_bits(), "{r} {c}");
@@ -578,75 +605,17 @@ pub(super) mod tests {
     /// are the callback's entries, bit for bit, held ends left out.
     #[test]
     fn blocks_into_the_band_on_two_threads_match_the_callback() {
-        let n = SPLIT_ASSEMBLY_FROM + 3001;
-        let spans = 2000;
-        let vars = spans + 3;
-        let first: Vec<usize> = (0..n)
-            .map(|i| {
-                let u = i as f64 / n as f64;
-                let v = u + 0.1 * (std::f64::consts::TAU * u).sin() / std::f64::consts::TAU;
-                ((v * spans as f64) as usize).min(spans - 1)
-            })
-            .collect();
-        let basis: Vec<[f64; 4]> = (0..n)
-            .map(|i| {
-                let u = (i as f64 * 0.37).fract();
-                [(1.0 - u) / 3.0, 0.4, u / 3.0, 0.1 + 0.01 * u]
-            })
-            .collect();
-        let map = SplineMap { vars, first, basis };
-        let design = Design::Spline(map.clone());
-        let blocks: Vec<[[f64; 2]; 2]> = (0..n)
-            .map(|i| {
-                let a = 1.0 + (i as f64 * 0.3).sin().abs();
-                let b = 0.2 * (i as f64 * 0.9).cos();
-                [[a, b], [b, 0.5 * a + 0.1]]
-            })
-            .collect();
-        let skip: Vec<bool> = (0..n).map(|i| i % 7 == 3).collect();
-        let dim = 2 * vars;
-        for held_ends in [false, true] {
-            let held: Vec<bool> = (0..vars)
-                .map(|j| held_ends && (j < 2 || j + 2 >= vars))
-                .collect();
-            let mut want = SymBanded::zeros(dim, 7);
-            design.for_each_block_lower::<2>(&blocks, &skip, |r, c, v| {
-                if !held[r / 2] && !held[c / 2] {
-                    want.add(r, c, v);
-                }
-            });
-            let mut got = SymBanded::zeros(dim, 7);
-            map.add_blocks_open::<2>(&blocks, &skip, &held, &mut got);
-            for r in 0..dim {
-                for c in r.saturating_sub(7)..=r {
-                    assert_eq!(got.get(r, c).to_bits(), want.get(r, c).to_bits(), "{r} {c}");
-                }
-            }
-        }
+        let map = long_map(SPLIT_ASSEMBLY_FROM + 3001, 2000);
+        let n = map.first.len();
+        assert_blocks_match(&map, &(0..n).map(|i| i % 7 == 3).collect::<Vec<_>>(), 2);
     }
 
     /// On a long curve (pieces in parallel) the weighted Gram matrix is reported in the
     /// calls one sweep makes, with the same sums bit for bit.
     #[test]
     fn weight_gram_in_pieces_matches_one_sweep() {
-        let n = PARALLEL_FROM + 5000;
-        let spans = 3000;
-        let vars = spans + 3;
-        // Uneven runs: span k holds about n/spans points, more near the middle.
-        let first: Vec<usize> = (0..n)
-            .map(|i| {
-                let u = i as f64 / n as f64;
-                let v = u + 0.1 * (std::f64::consts::TAU * u).sin() / std::f64::consts::TAU;
-                ((v * spans as f64) as usize).min(spans - 1)
-            })
-            .collect();
-        let basis: Vec<[f64; 4]> = (0..n)
-            .map(|i| {
-                let u = (i as f64 * 0.37).fract();
-                [(1.0 - u) / 3.0, 0.4, u / 3.0, 0.1 + 0.01 * u]
-            })
-            .collect();
-        let map = SplineMap { vars, first, basis };
+        let map = long_map(PARALLEL_FROM + 5000, 3000);
+        let n = map.first.len();
         let skip: Vec<bool> = (0..n).map(|i| i % 11 == 5).collect();
         let weight = |i: usize| 1.0 + (i as f64 * 0.01).sin().abs();
         let mut want = Vec::new();
