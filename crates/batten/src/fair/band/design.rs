@@ -85,7 +85,7 @@ impl SplineMap {
 
     /// Call `add(row, col, value)` for the entries with `row ≥ col` of the 4×4 block `acc`
     /// (every coordinate) of the span whose first control point is `f`.
-    fn add_span_lower<const D: usize>(
+    pub(super) fn add_span_lower<const D: usize>(
         &self,
         f: usize,
         acc: &[[f64; 4]; 4],

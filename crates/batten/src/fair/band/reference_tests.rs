@@ -494,3 +494,46 @@ fn the_rounds_check_is_asked_once_and_ends_the_run() {
             .all(|r| r[0] * r[0] + r[1] * r[1] <= 1.0)
     );
 }
+
+/// The spline form's data term from the knot spans' sums where a span's points share one
+/// weight gives the minimiser the sweep over every point gives, to rounding: weights in
+/// steps many spans long (as the local weights' rounds leave them), then smooth (as after
+/// their smoothing), open and closed.
+#[test]
+fn span_sums_give_the_sweeps_minimiser() {
+    use super::debias::Penalized;
+    for closed in [false, true] {
+        let case = SplineCase::new(1500, closed, Metric::Jerk, 40, false);
+        let problem = case.problem();
+        let unit = case.layout.energy_unit();
+        let fixed = vec![0.0; case.s.len()];
+        let fit = Penalized::new(
+            &case.energy,
+            unit,
+            &case.layout.design,
+            &case.held,
+            &case.pinned,
+            &fixed,
+            &problem.anchor,
+            &problem.centres,
+        );
+        let steps = |i: usize| unit * 1e-12 * 4f64.powi((i / 250) as i32 % 3);
+        let smooth = |i: usize| unit * 1e-12 * (1.5 + (i as f64 * 0.013).sin());
+        for (name, weight) in [
+            ("steps", &steps as &(dyn Fn(usize) -> f64 + Sync)),
+            ("smooth", &smooth),
+        ] {
+            let fast = fit.minimiser(weight, false).expect("minimiser");
+            let sweep = fit.minimiser_by_sweep(weight).expect("minimiser");
+            let size = sweep.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            let apart = fast
+                .iter()
+                .zip(&sweep)
+                .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(
+                apart <= 1e-9 * size,
+                "closed {closed}, {name}: {apart} of {size}"
+            );
+        }
+    }
+}
