@@ -21,7 +21,9 @@
 //! `λ_i`, each iteration linearises the conditions `∇f + Σ λ_i ∇h_i = 0`, `h + σ = 0`,
 //! `λ_i σ_i = μ`, takes an affine predictor step (target `μ = 0`), picks the centring
 //! `(μ_aff / μ)³` from how far it got, and takes the corrected step, 99 % of the way to the
-//! boundary of `λ, σ > 0` and shortened until every point stays strictly inside the band.
+//! boundary of `λ, σ > 0` and of the longest step that keeps every point inside its ball
+//! with a thousandth of its slack ([`ball_step`]). The multipliers start centred, at a gap
+//! equal to the objective's scale.
 //! Every iterate is feasible, so the slack is recomputed as `σ_i = −h_i` and the constraint
 //! residual `h + σ` is zero; the corrector's constraint target carries the second-order term
 //! `|Δy_i|²` of the predictor instead (see [`direction`]).
@@ -574,7 +576,7 @@ struct Ipm<'p, 'a, const D: usize> {
 }
 
 impl<'p, 'a, const D: usize> Ipm<'p, 'a, D> {
-    /// The start: strictly inside the band, multipliers 1.
+    /// The start: strictly inside the band, multipliers centred at the objective's scale.
     fn start(p: &'p Problem<'a, D>) -> Result<Ipm<'p, 'a, D>> {
         let energy = p.energy;
         let design = p.design;
