@@ -316,17 +316,8 @@ impl<'a, const D: usize> Penalized<'a, D> {
             } else {
                 let mut acc = [[0.0; 4]; 4];
                 for i in s.points.clone().filter(|&i| !pinned[i]) {
-                    let (b, w2) = (&map.basis[i], 2.0 * weight(i));
                     let c = &self.centres[i * D..(i + 1) * D];
-                    for k in 0..4 {
-                        let wb = w2 * b[k];
-                        for l in 0..4 {
-                            acc[k][l] += wb * b[l];
-                        }
-                        for a in 0..D {
-                            pull[k][a] += wb * c[a];
-                        }
-                    }
+                    add_weighted(&mut acc, &mut pull, 2.0 * weight(i), &map.basis[i], c);
                 }
                 gram = acc;
             }
@@ -701,14 +692,8 @@ impl<const D: usize> SpanSums<D> {
             let Some(s) = out.last_mut() else { continue };
             s.points.end = i + 1;
             let c = &centres[i * D..(i + 1) * D];
-            for k in 0..4 {
-                for l in 0..4 {
-                    s.gram[k][l] += b[k] * b[l];
-                }
-                for a in 0..D {
-                    s.pull[k][a] += b[k] * c[a];
-                }
-            }
+            // Weight 1: `1·b_k` is `b_k`, the plain sums.
+            add_weighted(&mut s.gram, &mut s.pull, 1.0, b, c);
             s.constant += c.iter().map(|v| v * v).sum::<f64>();
         }
         out
@@ -727,6 +712,26 @@ impl<const D: usize> SpanSums<D> {
             total -= 2.0 * (0..D).map(|a| yk[a] * self.pull[k][a]).sum::<f64>();
         }
         total
+    }
+}
+
+/// Add one point's share `w b bᵀ` and `w b cᵀ` (basis values `b`, centre `c`) to a knot
+/// span's sums.
+fn add_weighted<const D: usize>(
+    gram: &mut [[f64; 4]; 4],
+    pull: &mut [[f64; D]; 4],
+    w: f64,
+    b: &[f64; 4],
+    c: &[f64],
+) {
+    for k in 0..4 {
+        let wb = w * b[k];
+        for l in 0..4 {
+            gram[k][l] += wb * b[l];
+        }
+        for a in 0..D {
+            pull[k][a] += wb * c[a];
+        }
     }
 }
 

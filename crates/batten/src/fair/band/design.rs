@@ -6,6 +6,7 @@
 //! four consecutive control points, so every matrix the solver builds keeps the band of the
 //! energy (half-bandwidth `4D − 1` in the interleaved numbering).
 
+use super::energy::four_from;
 use crate::numeric::{BandRows, PARALLEL_FROM, SymBanded, map_indices};
 use rayon::prelude::*;
 
@@ -91,12 +92,7 @@ impl SplineMap {
         acc: &[[f64; 4]; 4],
         add: &mut impl FnMut(usize, usize, f64),
     ) {
-        // The span's control points, taken modulo the count once (not once per entry).
-        let at: [usize; 4] = if f + 4 <= self.vars {
-            std::array::from_fn(|k| (f + k) * D)
-        } else {
-            std::array::from_fn(|k| ((f + k) % self.vars) * D)
-        };
+        let at = four_from(f, self.vars).map(|j| j * D);
         for (row, &r0) in acc.iter().zip(&at) {
             for (v, &c0) in row.iter().zip(&at) {
                 if r0 >= c0 {

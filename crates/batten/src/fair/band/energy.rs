@@ -65,6 +65,17 @@ pub(super) struct Energy<const D: usize> {
     pub windows: Vec<Window<D>>,
 }
 
+/// The four consecutive indices from `first`, modulo `n` (cyclic windows and knot spans),
+/// taken once for a window rather than once per entry: an integer division each, skipped
+/// where nothing wraps.
+pub(super) fn four_from(first: usize, n: usize) -> [usize; 4] {
+    if first + 4 <= n {
+        std::array::from_fn(|k| first + k)
+    } else {
+        std::array::from_fn(|k| (first + k) % n)
+    }
+}
+
 /// The chord lengths of `shape`, cyclic when closed.
 pub(super) fn chords_of<const D: usize>(shape: &[[f64; D]], closed: bool) -> Vec<f64> {
     let n = shape.len();
@@ -375,12 +386,7 @@ impl<const D: usize> Energy<D> {
     /// index first as well. Entries at the same position are reported once per window.
     pub(super) fn for_each_lower(&self, scale: f64, mut add: impl FnMut(usize, usize, f64)) {
         for w in &self.windows {
-            // The window's points, taken modulo n once (not once per entry).
-            let at: [usize; 4] = if w.first + 4 <= self.n {
-                std::array::from_fn(|k| w.first + k)
-            } else {
-                std::array::from_fn(|k| (w.first + k) % self.n)
-            };
+            let at = four_from(w.first, self.n);
             for (k, &i) in at.iter().enumerate() {
                 for (l, &j) in at.iter().enumerate() {
                     let cc = scale * w.coef[k] * w.coef[l];
