@@ -21,7 +21,7 @@
 //! The constrained problem is then solved once with those weights by the interior point.
 
 use super::design::{Design, SplineMap};
-use super::energy::Energy;
+use super::energy::{Energy, four_from};
 use crate::error::Result;
 use crate::numeric::{Bracket, CyclicSymBanded, PARALLEL_FROM, SymBanded, map_indices};
 use rayon::prelude::*;
@@ -96,8 +96,6 @@ pub(super) struct Penalized<'a, const D: usize> {
     coupling: Vec<f64>,
     /// `2 BᵀB` on the free unknowns, lower entries (the spline form; empty for points).
     gram: Vec<(usize, usize, f64)>,
-    /// `c − B x_held` at the free points (zero at pinned ones).
-    shifted: Vec<f64>,
     /// `2 Bᵀ (c − B x_held)`.
     pull: Vec<f64>,
     /// The spline form's residual sums by knot span (empty in the point form).
@@ -151,44 +149,29 @@ impl<'a, const D: usize> Penalized<'a, D> {
                 top = top.max(v.abs());
             }
         });
-        let mut gram = Vec::new();
-        let mut sums = Vec::new();
-        if let Design::Spline(map) = design {
-            sums = SpanSums::of(map, pinned, centres);
-            // Summed in a band array (offsets `c − r` in `[−bw, bw]`, wrapped for closed
-            // curves), then listed.
-            let width = 2 * bw + 1;
-            let mut band = vec![0.0; dim * width];
-            design.for_each_weight_lower::<D>(
-                |_| 2.0,
-                pinned,
-                |r, c, v| {
-                    if !held[r / D] && !held[c / D] {
-                        band[r * width + offset(r, c, dim, bw)] += v;
-                    }
-                },
-            );
-            for (k, v) in band.iter().enumerate() {
-                if *v != 0.0 {
-                    let r = k / width;
-                    let c = (r + dim + k % width - bw) % dim;
-                    gram.push((r, c, *v));
-                }
+        // The data term's parts that do not depend on the weights: in the spline form from
+        // the knot spans' sums (one sweep over the points), in the point form per point.
+        let (gram, pull, sums) = match design {
+            Design::Spline(map) => {
+                let sums = SpanSums::of(map, pinned, centres);
+                let gram = span_gram(map, &sums, held);
+                let pull = span_pull(map, &sums, &fixed);
+                (gram, pull, sums)
             }
-        }
-        // The data term's pull on the free unknowns: towards the centres less what the held
-        // unknowns already give the points (in the point form they give only their own).
-        let mut shifted = vec![0.0; design.points() * D];
-        design.eval_then::<D>(&fixed, &mut shifted, |i, q| {
-            if pinned[i] {
-                [0.0; D]
-            } else {
-                std::array::from_fn(|a| centres[i * D + a] - q[a])
+            Design::Points { .. } => {
+                // `2 (c − x_held)` at the free points: the point form's `2 Bᵀ (c − B x_held)`.
+                let pull = (0..dim)
+                    .map(|k| {
+                        if pinned[k / D] {
+                            0.0
+                        } else {
+                            2.0 * (centres[k] - fixed[k])
+                        }
+                    })
+                    .collect();
+                (Vec::new(), pull, Vec::new())
             }
-        });
-        let mut pull = vec![0.0; dim];
-        let doubled: Vec<f64> = shifted.iter().map(|s| 2.0 * s).collect();
-        design.eval_t_add::<D>(&doubled, &mut pull);
+        };
         Penalized {
             energy,
             design,
@@ -202,7 +185,6 @@ impl<'a, const D: usize> Penalized<'a, D> {
             gram,
             pull,
             sums,
-            shifted,
             top,
             unit,
         }
@@ -267,13 +249,23 @@ impl<'a, const D: usize> Penalized<'a, D> {
                 }
             },
         );
-        let weighted: Vec<f64> = self
-            .shifted
-            .iter()
-            .enumerate()
-            .map(|(k, c)| 2.0 * weight(k / D) * c)
-            .collect();
+        let mut weighted = vec![0.0; self.points() * D];
+        self.design
+            .eval_then::<D>(&self.fixed, &mut weighted, |i, q| {
+                let w = 2.0 * weight(i);
+                self.shifted(i, q).map(|c| w * c)
+            });
         self.design.eval_t_add::<D>(&weighted, y);
+    }
+
+    /// `c_i − (B x_held)_i` at a free point `i` (`q` the held unknowns' value there), zero at
+    /// a pinned one: what the data term pulls point `i` towards.
+    fn shifted(&self, i: usize, q: [f64; D]) -> [f64; D] {
+        if self.pinned[i] {
+            [0.0; D]
+        } else {
+            std::array::from_fn(|a| self.centres[i * D + a] - q[a])
+        }
     }
 
     /// [`Penalized::minimiser`] by the sweep over every point, for the tests.
@@ -364,7 +356,7 @@ impl<'a, const D: usize> Penalized<'a, D> {
         let (mut m, mut y) = self.uniform_spline_term(mu);
         for &i in raised.iter().filter(|&&i| !self.pinned[i]) {
             let extra = 2.0 * (weights[i] - mu);
-            let shifted: [f64; D] = std::array::from_fn(|a| self.shifted[i * D + a]);
+            let shifted = self.shifted(i, map.point::<D>(i, &self.fixed));
             map.add_point::<D>(
                 i,
                 extra,
@@ -715,6 +707,56 @@ impl<const D: usize> SpanSums<D> {
     }
 }
 
+/// `2 BᵀB` on the free unknowns (entries of `held` ones left out), lower entries, from the
+/// knot spans' sums: a span's `2 Σ b bᵀ` is its sum of `(2 b) bᵀ` (doubling is exact), so
+/// these are the sums [`Design::for_each_weight_lower`] gives at weight 2, bit for bit,
+/// without a second sweep over the points. Listed in the order of a band array (offsets
+/// `c − r` in `[−bw, bw]`, wrapped for closed curves), zeros left out.
+fn span_gram<const D: usize>(
+    map: &SplineMap,
+    sums: &[SpanSums<D>],
+    held: &[bool],
+) -> Vec<(usize, usize, f64)> {
+    let dim = map.vars * D;
+    let bw = 4 * D - 1;
+    let width = 2 * bw + 1;
+    let mut band = vec![0.0; dim * width];
+    for s in sums {
+        let doubled = s.gram.map(|row| row.map(|g| 2.0 * g));
+        map.add_span_lower::<D>(s.first, &doubled, &mut |r, c, v| {
+            if !held[r / D] && !held[c / D] {
+                band[r * width + offset(r, c, dim, bw)] += v;
+            }
+        });
+    }
+    let mut gram = Vec::new();
+    for (k, v) in band.iter().enumerate() {
+        if *v != 0.0 {
+            let r = k / width;
+            let c = (r + dim + k % width - bw) % dim;
+            gram.push((r, c, *v));
+        }
+    }
+    gram
+}
+
+/// `2 Bᵀ (c − B x_held)` over the free points, from the knot spans' sums: on a span
+/// `Σ_i b_ik (c_i − Σ_l b_il x_l) = H_k − Σ_l G_kl x_l` (`x` the held unknowns' values,
+/// zero elsewhere).
+fn span_pull<const D: usize>(map: &SplineMap, sums: &[SpanSums<D>], fixed: &[f64]) -> Vec<f64> {
+    let mut pull = vec![0.0; map.vars * D];
+    for s in sums {
+        let at = four_from(s.first, map.vars);
+        for (k, &j) in at.iter().enumerate() {
+            for a in 0..D {
+                let held_part: f64 = (0..4).map(|l| s.gram[k][l] * fixed[at[l] * D + a]).sum();
+                pull[j * D + a] += 2.0 * (s.pull[k][a] - held_part);
+            }
+        }
+    }
+    pull
+}
+
 /// Add one point's share `w b bᵀ` and `w b cᵀ` (basis values `b`, centre `c`) to a knot
 /// span's sums.
 fn add_weighted<const D: usize>(
@@ -1048,6 +1090,66 @@ mod tests {
                 .map(|s| s.value(map.vars, &y))
                 .sum();
             assert!((got - want).abs() < 1e-12 * want, "{got} {want}");
+        }
+    }
+
+    /// The Gram matrix and the pull taken from the span sums are those of the sweeps over
+    /// every point they replace: the Gram matrix bit for bit (the sweep's sums at weight 2,
+    /// in the same order), the pull to rounding, with held ends and pinned points.
+    #[test]
+    fn span_sums_give_the_sweeps_gram_and_pull() {
+        for closed in [false, true] {
+            let map = crate::fair::band::design::tests::map(closed);
+            let (n, vars) = (map.first.len(), map.vars);
+            let pinned: Vec<bool> = (0..n).map(|i| i == 0 || i % 4 == 3).collect();
+            let held: Vec<bool> = (0..vars)
+                .map(|j| !closed && (j == 0 || j + 1 == vars))
+                .collect();
+            let centres: Vec<f64> = (0..2 * n).map(|k| (k as f64 * 0.37).cos()).collect();
+            let fixed: Vec<f64> = (0..2 * vars)
+                .map(|k| {
+                    if held[k / 2] {
+                        (k as f64 * 0.9).sin()
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+            let sums = SpanSums::<2>::of(&map, &pinned, &centres);
+            let design = Design::Spline(map.clone());
+            let dim = 2 * vars;
+            let (bw, width) = (7, 15);
+            let mut band = vec![0.0; dim * width];
+            design.for_each_weight_lower::<2>(
+                |_| 2.0,
+                &pinned,
+                |r, c, v| {
+                    if !held[r / 2] && !held[c / 2] {
+                        band[r * width + offset(r, c, dim, bw)] += v;
+                    }
+                },
+            );
+            let swept: Vec<(usize, usize, f64)> = band
+                .iter()
+                .enumerate()
+                .filter(|(_, v)| **v != 0.0)
+                .map(|(k, v)| (k / width, (k / width + dim + k % width - bw) % dim, *v))
+                .collect();
+            assert_eq!(span_gram(&map, &sums, &held), swept, "closed {closed}");
+            let mut shifted = vec![0.0; 2 * n];
+            design.eval_then::<2>(&fixed, &mut shifted, |i, q| {
+                if pinned[i] {
+                    [0.0; 2]
+                } else {
+                    std::array::from_fn(|a| 2.0 * (centres[i * 2 + a] - q[a]))
+                }
+            });
+            let mut want = vec![0.0; dim];
+            design.eval_t_add::<2>(&shifted, &mut want);
+            let got = span_pull(&map, &sums, &fixed);
+            for (g, w) in got.iter().zip(&want) {
+                assert!((g - w).abs() <= 1e-13, "closed {closed}: {g} {w}");
+            }
         }
     }
 

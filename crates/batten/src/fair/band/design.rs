@@ -39,7 +39,7 @@ pub(super) struct SplineMap {
 
 impl SplineMap {
     /// Point `i` of the spline with control points `x` (flat, `D` numbers each).
-    fn point<const D: usize>(&self, i: usize, x: &[f64]) -> [f64; D] {
+    pub(super) fn point<const D: usize>(&self, i: usize, x: &[f64]) -> [f64; D] {
         self.point_at::<D>(self.first[i], &self.basis[i], x)
     }
 
