@@ -227,6 +227,17 @@ pub trait FairMethod: Sync {
         true
     }
 
+    /// Whether the input's measures, when they run while the method does (see
+    /// [`FairMethod::checks_moves`]), run in the background, at the lowest scheduling
+    /// priority on the cores the method leaves idle: for a method whose run is long and
+    /// mostly serial with parallel stretches (`band`'s interior point), which the measures
+    /// beside it at the same priority would slow. `false` (the default): beside it at the
+    /// same priority, which suits a short run (`mst`: its 10⁶-point fair took 0.50 s either
+    /// way in the foreground and 0.52 s with its measures in the background).
+    fn measures_in_background(&self) -> bool {
+        false
+    }
+
     /// The method's parameters given in data units, as `(name, power of length)` pairs: the
     /// default [`params_at_scale`](FairMethod::params_at_scale) and
     /// [`report_params_at_scale`](FairMethod::report_params_at_scale) convert them. The
@@ -424,8 +435,9 @@ pub fn fair_with_beside<T: Send>(
         (before, ran)
     } else {
         // The input's measures and the method are independent.
-        let (before, ran) =
-            beside_if_long(input.len(), measure, || run_method(m, input, options, None));
+        let (before, ran) = measures_beside(m, input.len(), measure, || {
+            run_method(m, input, options, None)
+        });
         (before?, ran)
     };
     let Ran {
@@ -464,6 +476,23 @@ fn beside_if_long<A: Send, B: Send>(
         (a(), b())
     } else {
         rayon::join(a, b)
+    }
+}
+
+/// The input's measures `measure()` and the method's run `method()` of `m` on a curve of `n`
+/// points: side by side from [`MEASURE_BESIDE_FROM`] points on ([`beside_if_long`]), the
+/// measures in the background for a method that asks for it
+/// ([`FairMethod::measures_in_background`]).
+fn measures_beside<A: Send, B: Send>(
+    m: &dyn FairMethod,
+    n: usize,
+    measure: impl FnOnce() -> A + Send,
+    method: impl FnOnce() -> B + Send,
+) -> (A, B) {
+    if m.measures_in_background() && n >= MEASURE_BESIDE_FROM {
+        crate::numeric::beside_in_background(measure, method)
+    } else {
+        beside_if_long(n, measure, method)
     }
 }
 

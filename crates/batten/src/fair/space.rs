@@ -137,7 +137,7 @@ pub fn fair_space(name: &str, input: &SpaceSeq, options: &FairOptions) -> Result
     // The input's measures and the method are independent (no space method checks single
     // moves).
     let measure = || SpaceMetrics::of_seq(&scaled_seq(input, 1.0 / unit_scale)?);
-    let (before, ran) = super::beside_if_long(input.len(), measure, || {
+    let (before, ran) = super::measures_beside(m, input.len(), measure, || {
         run_method(m, input, options, unit_scale)
     });
     let before = before?;

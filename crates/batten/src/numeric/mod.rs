@@ -25,7 +25,7 @@ pub(crate) use bracket::SLACK as BRACKET_SLACK;
 pub use cyclic_banded::CyclicSymBanded;
 pub use minimize::{Minimum, minimize_brent, minimize_golden};
 pub use nelder_mead::{NelderMeadParams, SimplexMinimum, minimize_nelder_mead};
-pub(crate) use parallel::{PARALLEL_FROM, map_indices};
+pub(crate) use parallel::{PARALLEL_FROM, beside_in_background, map_indices};
 pub use quadrature::GaussLegendre;
 pub use tridiagonal::{solve_cyclic_tridiagonal, solve_tridiagonal};
 

@@ -117,6 +117,13 @@ impl FairMethod for Band {
         false
     }
 
+    /// Its interior point's iterations are serial but for the Newton matrix's assembly and
+    /// factorisation, which take the second core in short stretches: the input's measures
+    /// run in the background (#14's 10⁶-point sine: 0.05 s less).
+    fn measures_in_background(&self) -> bool {
+        true
+    }
+
     fn name(&self) -> &'static str {
         "band"
     }
