@@ -326,7 +326,7 @@ fn fair_points<const D: usize>(
     // The first pass's reference and parameters: the input, averaged where the noise is as
     // large as the spacing.
     let mut shape: Vec<[f64; D]> = if dense {
-        moving_average(pts, closed, dense_parameter_window(pts, closed, tolerance))
+        dense_parameter_average(pts, closed, tolerance)
     } else {
         smoothed_for_parameters(pts, closed, tolerance)
     };
@@ -569,11 +569,16 @@ fn parameter_window<const D: usize>(pts: &[[f64; D]], tolerance: f64) -> usize {
     }
 }
 
-/// The half-width of the parameter window for dense points: as [`parameter_window`], but with
-/// the spacing re-measured on the averaged points until the window stops growing. Where the
-/// noise is much larger than the spacing the input's median chord is noise, and a window set by
-/// it leaves the averaged chords noisy too.
-fn dense_parameter_window<const D: usize>(pts: &[[f64; D]], closed: bool, tolerance: f64) -> usize {
+/// The input averaged over the parameter window for dense points: as [`parameter_window`],
+/// but with the spacing re-measured on the averaged points until the window stops growing.
+/// Where the noise is much larger than the spacing the input's median chord is noise, and a
+/// window set by it leaves the averaged chords noisy too. (The last round's average is the
+/// result, not made again.)
+fn dense_parameter_average<const D: usize>(
+    pts: &[[f64; D]],
+    closed: bool,
+    tolerance: f64,
+) -> Vec<[f64; D]> {
     let n = pts.len();
     let mut m = parameter_window(pts, tolerance);
     for _ in 0..DENSE_WINDOW_ROUNDS {
@@ -582,15 +587,15 @@ fn dense_parameter_window<const D: usize>(pts: &[[f64; D]], closed: bool, tolera
         let mid = chords.len() / 2;
         let h = *chords.select_nth_unstable_by(mid, f64::total_cmp).1;
         if h <= 0.0 {
-            break;
+            return s;
         }
         let want = ((PARAMETER_WINDOW_TOLERANCES * tolerance / h).floor() as usize).min(n / 8);
         if want <= m {
-            break;
+            return s;
         }
         m = want;
     }
-    m
+    moving_average(pts, closed, m)
 }
 
 /// The input averaged over a moving window of `2m + 1` points (cyclic when closed; near the
