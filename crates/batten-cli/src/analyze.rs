@@ -55,7 +55,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<ExitCode, Failure> {
 
 /// The metrics as pretty JSON, with a final newline.
 fn json(metrics: &impl Serialize) -> Result<String, Failure> {
-    let mut s = serde_json::to_string_pretty(metrics)
+    let mut s = crate::json::pretty(metrics)
         .map_err(|e| Failure::failed(anyhow!("cannot encode the metrics: {e}")))?;
     s.push('\n');
     Ok(s)

@@ -50,7 +50,7 @@ pub fn run(args: &CompareArgs) -> Result<ExitCode, Failure> {
         TableFormat::Md => markdown(&table(&name, &data.seq, &base, &before, rows)),
         TableFormat::Csv => csv(&before, rows),
         TableFormat::Json => {
-            let mut s = serde_json::to_string_pretty(&to_json(&name, &base, &before, rows))
+            let mut s = crate::json::pretty(&to_json(&name, &base, &before, rows))
                 .map_err(|e| Failure::failed(anyhow!("cannot encode the table: {e}")))?;
             s.push('\n');
             s

@@ -110,7 +110,7 @@ pub fn run(args: &EvaluateArgs) -> Result<ExitCode, Failure> {
     }
     .map_err(|e| Failure::from_batten(&what, e))?;
     let text = if args.json {
-        let mut s = serde_json::to_string_pretty(&evaluation)
+        let mut s = crate::json::pretty(&evaluation)
             .map_err(|e| Failure::failed(anyhow!("cannot encode the evaluation: {e}")))?;
         s.push('\n');
         s

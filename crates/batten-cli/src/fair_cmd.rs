@@ -368,7 +368,7 @@ fn curve_bytes(
 
 /// The report as pretty JSON.
 pub fn report_json(report: &impl serde::Serialize) -> Result<String, Failure> {
-    let mut json = serde_json::to_string_pretty(report)
+    let mut json = crate::json::pretty(report)
         .map_err(|e| Failure::failed(anyhow!("cannot encode the report: {e}")))?;
     json.push('\n');
     Ok(json)

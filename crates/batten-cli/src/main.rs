@@ -20,6 +20,7 @@ mod fair_space_cmd;
 mod figure;
 mod formats;
 mod input;
+mod json;
 mod methods;
 mod output;
 mod plot;

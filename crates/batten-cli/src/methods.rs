@@ -26,7 +26,7 @@ pub struct MethodsArgs {
 /// Only a failed write to stdout.
 pub fn run(args: &MethodsArgs) -> Result<ExitCode, Failure> {
     let text = if args.json {
-        let mut s = serde_json::to_string_pretty(&fair::catalogue())
+        let mut s = crate::json::pretty(&fair::catalogue())
             .map_err(|e| Failure::failed(anyhow!("cannot encode the methods: {e}")))?;
         s.push('\n');
         s

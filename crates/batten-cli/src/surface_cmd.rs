@@ -83,7 +83,7 @@ pub fn analyze(args: &AnalyzeSurfaceArgs) -> Result<ExitCode, Failure> {
     let s = io::read_surface_json(&args.input).map_err(Failure::usage)?;
     let a = analyze_surface(&s);
     let text = if args.json {
-        let mut t = serde_json::to_string_pretty(&a)
+        let mut t = crate::json::pretty(&a)
             .map_err(|e| Failure::failed(anyhow!("cannot encode the analysis: {e}")))?;
         t.push('\n');
         t
@@ -179,7 +179,7 @@ pub fn fair(args: &FairSurfaceArgs) -> Result<ExitCode, Failure> {
     })?;
     io::write_surface_json(&args.output, &faired).map_err(Failure::failed)?;
     if let Some(r) = &args.report {
-        let mut text = serde_json::to_string_pretty(&report)
+        let mut text = crate::json::pretty(&report)
             .map_err(|e| Failure::failed(anyhow!("cannot encode the report: {e}")))?;
         text.push('\n');
         io::write_atomic(r, text.as_bytes()).map_err(Failure::failed)?;

@@ -241,8 +241,8 @@ fn write_dxf(job: &Job, drawing: &DxfDrawing, faired: &[(&DxfCurve, Done)]) -> R
         })
         .collect();
     drawing.to_bytes().map_err(|e| e.to_string()).and_then(|b| {
-        let mut json = serde_json::to_string_pretty(&reports)
-            .map_err(|e| format!("cannot encode the reports: {e}"))?;
+        let mut json =
+            crate::json::pretty(&reports).map_err(|e| format!("cannot encode the reports: {e}"))?;
         json.push('\n');
         io::write_atomic_set(&[(&job.report, json.as_bytes()), (&job.output, &b)])
             .map_err(|e| e.to_string())

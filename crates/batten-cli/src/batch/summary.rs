@@ -227,8 +227,8 @@ pub(super) fn write_on_interrupt(
 
 /// The summary as a pretty JSON array, one object per row, keys in [`Row`]'s order.
 fn summary_json(rows: &[Row]) -> Result<String, String> {
-    let mut json = serde_json::to_string_pretty(rows)
-        .map_err(|e| format!("cannot encode the summary: {e}"))?;
+    let mut json =
+        crate::json::pretty(rows).map_err(|e| format!("cannot encode the summary: {e}"))?;
     json.push('\n');
     Ok(json)
 }
