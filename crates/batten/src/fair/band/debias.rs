@@ -394,9 +394,14 @@ impl<'a, const D: usize> Penalized<'a, D> {
     /// The residual `B y − c` of every point (zero at pinned points).
     pub(super) fn residual(&self, y: &[f64]) -> Vec<f64> {
         let mut r = vec![0.0; self.points() * D];
-        self.design
-            .residual::<D>(y, self.centres, Some(self.pinned), &mut r);
+        self.residual_into(y, &mut r);
         r
+    }
+
+    /// [`Penalized::residual`] into `r` (`D` numbers a point).
+    fn residual_into(&self, y: &[f64], r: &mut [f64]) {
+        self.design
+            .residual::<D>(y, self.centres, Some(self.pinned), r);
     }
 
     /// The length `|(B y)_i − c_i|` of every point's residual (zero at pinned points), as
@@ -526,26 +531,32 @@ impl<'a, const D: usize> Penalized<'a, D> {
         let Ok(mut y) = self.minimiser(|i| weights[i], false) else {
             return Ok((weights, 0));
         };
+        // The rounds' buffers, made once (at 10⁶ points each round's new ones cost it a few
+        // milliseconds of page faults).
+        let closed = self.energy.closed;
+        let mut flat = vec![0.0; n * D];
+        let mut windows = Windows::<D>::empty(closed);
+        let mut marked = vec![0; n];
+        let mut raise = Marks::new(n, closed);
         for _ in 0..LOCAL_ROUNDS {
             // The residual (zero at held points, which the minimiser leaves at their centres).
-            let flat = self.residual(&y);
-            let windows = Windows::<D>::new(&flat, self.pinned, self.energy.closed);
-            let marked = windows.significant(&weights, self.unit, threshold);
+            self.residual_into(&y, &mut flat);
+            windows.refill(&flat, self.pinned);
+            windows.significant_into(&weights, self.unit, threshold, &mut marked);
             if marked.iter().all(|h| *h == 0) {
                 break;
             }
-            let mut raise = Marks::new(n, self.energy.closed);
+            raise.clear();
             for (i, &half) in marked.iter().enumerate() {
                 if half > 0 {
                     raise.mark(i, half);
                 }
             }
-            let raise = raise.finish();
             let trial: Vec<f64> = weights
                 .iter()
-                .zip(&raise)
+                .zip(raise.marked())
                 .map(|(w, r)| {
-                    if *r {
+                    if r {
                         (w * LOCAL_FACTOR).min(self.unit)
                     } else {
                         *w
@@ -801,10 +812,29 @@ struct Windows<const D: usize> {
 
 impl<const D: usize> Windows<D> {
     /// The prefix sums of `residual` (flat, `D` numbers a point) over the points not `held`.
+    #[cfg(test)]
     fn new(residual: &[f64], held: &[bool], closed: bool) -> Windows<D> {
-        let n = held.len();
-        let mut sums = Vec::with_capacity(n + 1);
-        let mut counts = Vec::with_capacity(n + 1);
+        let mut w = Windows::empty(closed);
+        w.refill(residual, held);
+        w
+    }
+
+    /// No points yet (see [`Windows::refill`]).
+    fn empty(closed: bool) -> Windows<D> {
+        Windows {
+            sums: Vec::new(),
+            counts: Vec::new(),
+            closed,
+        }
+    }
+
+    /// The prefix sums of `residual` over the points not `held`, in the arrays of the last.
+    fn refill(&mut self, residual: &[f64], held: &[bool]) {
+        let (sums, counts) = (&mut self.sums, &mut self.counts);
+        sums.clear();
+        counts.clear();
+        sums.reserve(held.len() + 1);
+        counts.reserve(held.len() + 1);
         let (mut s, mut c) = ([0.0; D], 0);
         sums.push(s);
         counts.push(c);
@@ -818,11 +848,6 @@ impl<const D: usize> Windows<D> {
             sums.push(s);
             counts.push(c);
         }
-        Windows {
-            sums,
-            counts,
-            closed,
-        }
     }
 
     fn n(&self) -> usize {
@@ -835,23 +860,26 @@ impl<const D: usize> Windows<D> {
     /// In parallel pieces (each point on its own: the same marks whatever the split); the
     /// half-width is computed once for each run of equal weights (the weights take a few
     /// values, and a power per point was most of a round's time at 10⁶ points).
+    #[cfg(test)]
     fn significant(&self, weights: &[f64], unit: f64, threshold: f64) -> Vec<usize> {
+        let mut marked = vec![0; self.n()];
+        self.significant_into(weights, unit, threshold, &mut marked);
+        marked
+    }
+
+    /// [`Windows::significant`] into `marked` (one entry a point, overwritten).
+    fn significant_into(&self, weights: &[f64], unit: f64, threshold: f64, marked: &mut [usize]) {
         let n = self.n();
         let half_of = |w: f64| self.half_width((w / unit).powf(-1.0 / 6.0));
-        let mut marked = vec![0; n];
         let piece = |from: usize, out: &mut [usize]| {
             let mut halves = RunCache::default();
             for (k, o) in out.iter_mut().enumerate() {
                 let i = from + k;
                 let half = halves.get(weights[i], half_of);
                 let (sum, count) = self.sum(i, half);
-                if count == 0 {
-                    continue;
-                }
-                let norm2: f64 = sum.iter().map(|s| s * s).sum::<f64>() / count as f64;
-                if norm2 > threshold {
-                    *o = half;
-                }
+                let significant =
+                    count > 0 && sum.iter().map(|s| s * s).sum::<f64>() / count as f64 > threshold;
+                *o = if significant { half } else { 0 };
             }
         };
         if n >= PARALLEL_FROM {
@@ -860,9 +888,8 @@ impl<const D: usize> Windows<D> {
                 .enumerate()
                 .for_each(|(c, out)| piece(c * SIGNIFICANT_CHUNK, out));
         } else {
-            piece(0, &mut marked);
+            piece(0, marked);
         }
-        marked
     }
 
     /// The half-width of a window `length` points long: at least 2, and the window no longer
@@ -943,16 +970,24 @@ impl Marks {
         }
     }
 
-    /// Whether each point lies in a marked window.
-    fn finish(self) -> Vec<bool> {
+    /// No window marked (the array kept for the next round's marks).
+    fn clear(&mut self) {
+        self.diff.fill(0);
+    }
+
+    /// Whether each point lies in a marked window, in order.
+    fn marked(&self) -> impl Iterator<Item = bool> + '_ {
         let n = self.diff.len() - 1;
-        let mut depth = 0;
-        (0..n)
-            .map(|j| {
-                depth += self.diff[j];
-                depth > 0
-            })
-            .collect()
+        self.diff[..n].iter().scan(0, |depth, d| {
+            *depth += d;
+            Some(*depth > 0)
+        })
+    }
+
+    /// [`Marks::marked`], collected.
+    #[cfg(test)]
+    fn finish(self) -> Vec<bool> {
+        self.marked().collect()
     }
 }
 
