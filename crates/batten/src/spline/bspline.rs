@@ -462,6 +462,14 @@ fn basis_only(u: &[f64], p: impl Degree, k: usize, t: f64, out: &mut [[f64; MAX_
     }
 }
 
+/// The four non-zero cubic basis functions `N_{k−3..=k, 3}` at `t` in span `k`: those
+/// [`basis_derivs`] gives with no derivative, bit for bit, without its table of derivatives
+/// (for the 10⁶ points of `band`'s spline layout).
+pub(crate) fn cubic_basis(u: &[f64], k: usize, t: f64) -> [f64; 4] {
+    let n = basis_functions(u, Cubic, k, t);
+    [n[0], n[1], n[2], n[3]]
+}
+
 /// The non-zero basis functions `N_{k−p..=k, p}` at `t` in span `k` (Piegl & Tiller A2.2,
 /// 0/0 := 0 for repeated knots), the rest of the array zero: each level's values overwrite
 /// the level before.
@@ -556,6 +564,27 @@ impl Piecewise for BSplineCurve {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The cubic basis alone is [`basis_derivs`]'s with no derivative, bit for bit, on a
+    /// clamped knot vector with uneven and repeated interior knots.
+    #[test]
+    fn cubic_basis_is_basis_derivs_without_derivatives() {
+        let u = [0.0, 0.0, 0.0, 0.0, 0.3, 0.3, 0.7, 1.1, 2.0, 2.0, 2.0, 2.0];
+        for k in 3..8 {
+            if u[k + 1] <= u[k] {
+                continue;
+            }
+            for step in 0..=20 {
+                let t = u[k] + (u[k + 1] - u[k]) * f64::from(step) / 20.0;
+                let mut out = [[0.0; MAX_ORDER]; 4];
+                basis_derivs(&u, 3, k, t, 0, &mut out);
+                let b = cubic_basis(&u, k, t);
+                for j in 0..4 {
+                    assert_eq!(b[j].to_bits(), out[0][j].to_bits(), "k {k} t {t} j {j}");
+                }
+            }
+        }
+    }
 
     /// The basis functions alone ([`basis_only`], nd = 0) are the bits of the full table's
     /// first row (nd ≥ 1), every degree, span and a spread of parameters, with repeated knots

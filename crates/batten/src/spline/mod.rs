@@ -23,8 +23,8 @@ mod parametric;
 // The radius-of-curvature analysis samples the quintic in closed form.
 pub(crate) mod quintic;
 
-pub(crate) use bspline::basis_derivs;
 pub use bspline::{BSplineCurve, MAX_ORDER};
+pub(crate) use bspline::{basis_derivs, cubic_basis};
 pub use bspline_ops::{DEVIATION_SAMPLES_PER_SPAN, KnotRef, KnotRemoval, RemovalRule};
 pub use function::{CubicSplineFn, FnEndCondition};
 pub use knots::KnotVector;
