@@ -44,6 +44,8 @@ struct Layout {
     has_member: Vec<bool>,
     /// The length of the line being written.
     column: usize,
+    /// A scalar's text before it is written (one buffer for all of them).
+    buffer: Vec<u8>,
 }
 
 impl Layout {
@@ -95,9 +97,12 @@ impl Layout {
         write: impl FnOnce(&mut CompactFormatter, &mut Vec<u8>) -> io::Result<()>,
     ) -> io::Result<()> {
         self.before_scalar(w)?;
-        let mut buffer = Vec::with_capacity(24);
+        let mut buffer = std::mem::take(&mut self.buffer);
+        buffer.clear();
         write(&mut CompactFormatter, &mut buffer)?;
-        self.text(w, &buffer)
+        let written = self.text(w, &buffer);
+        self.buffer = buffer;
+        written
     }
 }
 
