@@ -7,7 +7,7 @@
 //! energy (half-bandwidth `4D − 1` in the interleaved numbering).
 
 use super::energy::four_from;
-use crate::numeric::{BandRows, PARALLEL_FROM, SymBanded, map_indices};
+use crate::numeric::{BandRows, PARALLEL_FROM, SymBanded};
 use rayon::prelude::*;
 
 /// Points a task of [`Design::eval`] evaluates.
@@ -241,23 +241,17 @@ impl Design {
         }
     }
 
+    /// `(B x)_i`: point `i` of the unknowns `x`.
+    pub(super) fn value<const D: usize>(&self, i: usize, x: &[f64]) -> [f64; D] {
+        match self {
+            Design::Points { .. } => std::array::from_fn(|a| x[i * D + a]),
+            Design::Spline(s) => s.point::<D>(i, x),
+        }
+    }
+
     /// `out = B x` (flat, `D` numbers a point).
     pub(super) fn eval<const D: usize>(&self, x: &[f64], out: &mut [f64]) {
         self.eval_then::<D>(x, out, |_, q| q);
-    }
-
-    /// `f(i, (B x)_i)` for every point `i`, in order, evaluated in parallel pieces.
-    pub(super) fn map_points<const D: usize, T: Send>(
-        &self,
-        x: &[f64],
-        f: impl Fn(usize, [f64; D]) -> T + Sync + Send,
-    ) -> Vec<T> {
-        match self {
-            Design::Points { n } => (0..*n)
-                .map(|i| f(i, std::array::from_fn(|a| x[i * D + a])))
-                .collect(),
-            Design::Spline(s) => map_indices(s.first.len(), |i| f(i, s.point::<D>(i, x))),
-        }
     }
 
     /// `out = B x − c` (flat, `c` the ball centres `centres`), zero at the points `pinned`

@@ -241,16 +241,13 @@ pub(super) fn feasible_fit<const D: usize>(
         let Ok(x) = fit.minimiser_raised(mu, &weights, &raised) else {
             break;
         };
-        let lengths = fit.residual_lengths(&x);
-        let mut farthest = 0.0_f64;
-        for (w, (i, &len)) in weights.iter_mut().zip(lengths.iter().enumerate()) {
-            farthest = farthest.max(len);
-            if len > START_RADIUS {
-                if *w == mu {
-                    raised.push(i);
-                }
-                *w = (*w * (len / START_RADIUS).powi(4).max(2.0)).min(MAX_WEIGHT_GROWTH * mu);
+        let (farthest, far) = fit.far_points(&x, START_RADIUS);
+        for (i, len) in far {
+            let w = &mut weights[i];
+            if *w == mu {
+                raised.push(i);
             }
+            *w = (*w * (len / START_RADIUS).powi(4).max(2.0)).min(MAX_WEIGHT_GROWTH * mu);
         }
         if farthest <= START_RADIUS {
             return Ok(Some(x));
