@@ -435,9 +435,13 @@ pub fn fair_with_beside<T: Send>(
         (before, ran)
     } else {
         // The input's measures and the method are independent.
-        let (before, ran) = measures_beside(m, input.len(), measure, || {
-            run_method(m, input, options, None)
-        });
+        let method = || run_method(m, input, options, None);
+        let (before, ran) = if measures_in_background(m, input.len()) {
+            let unit = in_unit(input, unit_scale).into_owned();
+            crate::numeric::beside_in_background(unit, FairnessMetrics::of_seq, method)
+        } else {
+            beside_if_long(input.len(), measure, method)
+        };
         (before?, ran)
     };
     let Ran {
@@ -479,21 +483,12 @@ fn beside_if_long<A: Send, B: Send>(
     }
 }
 
-/// The input's measures `measure()` and the method's run `method()` of `m` on a curve of `n`
-/// points: side by side from [`MEASURE_BESIDE_FROM`] points on ([`beside_if_long`]), the
-/// measures in the background for a method that asks for it
-/// ([`FairMethod::measures_in_background`]).
-fn measures_beside<A: Send, B: Send>(
-    m: &dyn FairMethod,
-    n: usize,
-    measure: impl FnOnce() -> A + Send,
-    method: impl FnOnce() -> B + Send,
-) -> (A, B) {
-    if m.measures_in_background() && n >= MEASURE_BESIDE_FROM {
-        crate::numeric::beside_in_background(measure, method)
-    } else {
-        beside_if_long(n, measure, method)
-    }
+/// Whether the input's measures run in the background beside `m`'s run on a curve of `n`
+/// points ([`FairMethod::measures_in_background`], from [`MEASURE_BESIDE_FROM`] points on;
+/// `crate::numeric::beside_in_background`), rather than beside it in the foreground
+/// ([`beside_if_long`]).
+fn measures_in_background(m: &dyn FairMethod, n: usize) -> bool {
+    m.measures_in_background() && n >= MEASURE_BESIDE_FROM
 }
 
 /// What a method's run did (`run_method` here and in `space.rs`): the method's outcome,

@@ -20,49 +20,70 @@ pub(crate) fn map_indices<T: Send>(count: usize, f: impl Fn(usize) -> T + Sync +
     }
 }
 
-/// `background()` and `foreground()` side by side, `background` on threads of the lowest
-/// scheduling priority (on Linux `SCHED_IDLE`: it runs only on a core nothing else wants),
-/// `foreground` on the thread pool. For work a long computation does not need until its end
-/// (a fair's measures of its input): while the computation's serial stretches leave a core
-/// idle, the background work fills it, and where the computation runs in parallel it is not
-/// slowed (beside it at the same priority, the input's measures took the second core from a
-/// 10⁶-point `band`'s parallel start and cost it about 0.06 s).
+/// `background(&data)` and `foreground()` side by side, `background` on threads of the
+/// lowest scheduling priority (on Linux `SCHED_IDLE`: it runs only on a core nothing else
+/// wants), `foreground` on the thread pool. For work a long computation does not need until
+/// its end (a fair's measures of its input): while the computation's serial stretches leave a
+/// core idle, the background work fills it, and where the computation runs in parallel it is
+/// not slowed (beside it at the same priority, the input's measures took the second core from
+/// a 10⁶-point `band`'s parallel start and cost it about 0.06 s).
 ///
-/// The background work runs on a pool of its own (as many threads as the global one), handed
-/// over from a thread that waits for it without taking other work: within a batch, where
-/// every worker is busy, a worker that waits here blocks, which leaves its core to the
-/// background work, rather than starting another file (which would hold every file's data in
-/// memory until the measures could run). Without that pool (a platform that cannot start
-/// threads), the two run one after the other.
-pub(crate) fn beside_in_background<A: Send, B: Send>(
-    background: impl FnOnce() -> A + Send,
+/// The background never holds the caller up: when `foreground` is done and the background is
+/// not (a loaded machine gives an idle-priority thread almost nothing: a 10⁶-point fair waited
+/// 5.6 s for it beside a build), the caller computes `background(&data)` itself, at its own
+/// priority, and the background's copy, if it has begun, finishes unheeded; one not begun
+/// never starts, and keeps none of the data. The result is the same either way (the same
+/// function of the same data).
+pub(crate) fn beside_in_background<T, A, B>(
+    data: T,
+    background: fn(&T) -> A,
     foreground: impl FnOnce() -> B + Send,
-) -> (A, B) {
-    let Some(pool) = background_pool() else {
-        let a = background();
-        return (a, rayon::scope(|_| foreground()));
+) -> (A, B)
+where
+    T: Send + Sync + 'static,
+    A: Send + 'static,
+    B: Send,
+{
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::{Arc, Mutex};
+    // Nothing here waits on the background: an idle-priority thread stopped inside a
+    // critical section would hold the caller up as long as the machine stays busy. The task
+    // begins only if it claims the work before the caller does, reaches the data only through
+    // a weak reference (a task that never began keeps none of it), and the caller takes its
+    // result only if the result's lock is free.
+    struct Shared<A> {
+        claimed: AtomicBool,
+        result: Mutex<Option<A>>,
+    }
+    let data = Arc::new(data);
+    let shared = Arc::new(Shared {
+        claimed: AtomicBool::new(false),
+        result: Mutex::new(None),
+    });
+    if let Some(pool) = background_pool() {
+        let (weak, shared) = (Arc::downgrade(&data), Arc::clone(&shared));
+        pool.spawn(move || {
+            if shared.claimed.swap(true, Ordering::AcqRel) {
+                return;
+            }
+            let Some(d) = weak.upgrade() else { return };
+            let a = background(&d);
+            if let Ok(mut r) = shared.result.lock() {
+                *r = Some(a);
+            }
+        });
+    }
+    // On a worker of the global pool `scope` runs `foreground` in place; from outside it runs
+    // it on a worker, so that its own parallel parts stay in the pool.
+    let b = rayon::scope(|_| foreground());
+    let begun = shared.claimed.swap(true, Ordering::AcqRel);
+    let done = if begun {
+        shared.result.try_lock().ok().and_then(|mut r| r.take())
+    } else {
+        None
     };
-    // Taken by the thread that hands it over, or back here if that thread cannot start.
-    let task = std::sync::Mutex::new(Some(background));
-    let take = || task.lock().ok().and_then(|mut t| t.take());
-    std::thread::scope(|s| {
-        let handle = std::thread::Builder::new()
-            .name("batten-beside".into())
-            .spawn_scoped(s, || take().map(|f| pool.install(f)));
-        // On a worker of the global pool `scope` runs `foreground` in place; from outside it
-        // runs it on a worker, so that its own parallel parts stay in the pool.
-        let b = rayon::scope(|_| foreground());
-        let a = match handle.map(|h| h.join()) {
-            Ok(Ok(Some(a))) => Some(a),
-            Ok(Err(panic)) => std::panic::resume_unwind(panic),
-            Ok(Ok(None)) | Err(_) => None,
-        };
-        match a.or_else(|| take().map(|f| pool.install(f))) {
-            Some(a) => (a, b),
-            // The task is taken once: by the thread, which then returned it, or here.
-            None => unreachable!("the background task ran nowhere"),
-        }
-    })
+    let a = done.unwrap_or_else(|| background(&data));
+    (a, b)
 }
 
 /// The pool of [`beside_in_background`]: as many threads as the global pool, each at the
@@ -106,23 +127,31 @@ fn lowest_priority() {
 mod tests {
     use super::*;
 
-    /// Both results come back, the background one from the background pool, the foreground
-    /// one from the global pool, whether the caller is outside the pool or one of its
-    /// workers (as within a batch).
+    // `beside_in_background` takes `fn(&T)`, and `T` here is the vector.
+    #[allow(clippy::ptr_arg)]
+    fn total(v: &Vec<u64>) -> u64 {
+        v.iter().sum()
+    }
+
+    /// Both results come back, whether the background finished first or the caller computed
+    /// its part itself (a foreground that ends at once), called from outside the pool or from
+    /// one of its workers (as within a batch).
     #[test]
-    fn beside_in_background_runs_both_where_they_belong() {
-        let name = || std::thread::current().name().unwrap_or("").to_string();
-        let check = || {
+    fn beside_in_background_gives_both_results() {
+        let check = |wait: bool| {
             let data: Vec<u64> = (0..100_000).collect();
-            let (a, b) = beside_in_background(
-                || (data.iter().sum::<u64>(), name()),
-                || (data.len(), rayon::current_thread_index().is_some()),
-            );
-            assert_eq!(a.0, 4_999_950_000);
-            assert!(a.1.starts_with("batten-background-"), "{}", a.1);
-            assert_eq!(b, (100_000, true));
+            let (a, b) = beside_in_background(data, total, || {
+                if wait {
+                    std::thread::sleep(std::time::Duration::from_millis(50));
+                }
+                rayon::current_thread_index().is_some()
+            });
+            assert_eq!(a, 4_999_950_000);
+            assert!(b, "the foreground runs on the pool");
         };
-        check();
-        rayon::scope(|_| check());
+        for wait in [true, false] {
+            check(wait);
+            rayon::scope(|_| check(wait));
+        }
     }
 }
