@@ -435,13 +435,13 @@ pub fn fair_with_beside<T: Send>(
         (before, ran)
     } else {
         // The input's measures and the method are independent.
-        let method = || run_method(m, input, options, None);
-        let (before, ran) = if measures_in_background(m, input.len()) {
-            let unit = in_unit(input, unit_scale).into_owned();
-            crate::numeric::beside_in_background(unit, FairnessMetrics::of_seq, method)
-        } else {
-            beside_if_long(input.len(), measure, method)
-        };
+        let (before, ran) = measures_beside(
+            m,
+            input.len(),
+            || in_unit(input, unit_scale),
+            FairnessMetrics::of_seq,
+            || run_method(m, input, options, None),
+        );
         (before?, ran)
     };
     let Ran {
@@ -483,12 +483,29 @@ fn beside_if_long<A: Send, B: Send>(
     }
 }
 
-/// Whether the input's measures run in the background beside `m`'s run on a curve of `n`
-/// points ([`FairMethod::measures_in_background`], from [`MEASURE_BESIDE_FROM`] points on;
-/// `crate::numeric::beside_in_background`), rather than beside it in the foreground
-/// ([`beside_if_long`]).
-fn measures_in_background(m: &dyn FairMethod, n: usize) -> bool {
-    m.measures_in_background() && n >= MEASURE_BESIDE_FROM
+/// The input's measures, `measure` of `data()` (the input in the units it is measured in),
+/// and `m`'s run `method()` on a curve of `n` points, side by side: in the background for a
+/// method that asks for it ([`FairMethod::measures_in_background`], from
+/// [`MEASURE_BESIDE_FROM`] points on; `crate::numeric::beside_in_background`, which takes
+/// the data owned), else in the foreground ([`beside_if_long`], on the data as it comes).
+/// For the planar and the space fair alike.
+fn measures_beside<'a, T, A, B>(
+    m: &dyn FairMethod,
+    n: usize,
+    data: impl FnOnce() -> Cow<'a, T> + Send,
+    measure: fn(&T) -> A,
+    method: impl FnOnce() -> B + Send,
+) -> (A, B)
+where
+    T: Clone + Send + Sync + 'static,
+    A: Send + 'static,
+    B: Send,
+{
+    if m.measures_in_background() && n >= MEASURE_BESIDE_FROM {
+        crate::numeric::beside_in_background(data().into_owned(), measure, method)
+    } else {
+        beside_if_long(n, || measure(&data()), method)
+    }
 }
 
 /// What a method's run did (`run_method` here and in `space.rs`): the method's outcome,

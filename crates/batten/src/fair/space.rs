@@ -136,16 +136,13 @@ pub fn fair_space(name: &str, input: &SpaceSeq, options: &FairOptions) -> Result
     let unit_scale = unit_scale_xyz(input.points());
     // The input's measures and the method are independent (no space method checks single
     // moves).
-    let measure =
-        |scaled: &Result<SpaceSeq>| SpaceMetrics::of_seq(scaled.as_ref().map_err(Clone::clone)?);
-    let method = || run_method(m, input, options, unit_scale);
-    let (before, ran) = if super::measures_in_background(m, input.len()) {
-        let scaled = scaled_seq(input, 1.0 / unit_scale);
-        crate::numeric::beside_in_background(scaled, measure, method)
-    } else {
-        let measure = || measure(&scaled_seq(input, 1.0 / unit_scale));
-        super::beside_if_long(input.len(), measure, method)
-    };
+    let (before, ran) = super::measures_beside(
+        m,
+        input.len(),
+        || std::borrow::Cow::Owned(scaled_seq(input, 1.0 / unit_scale)),
+        |scaled: &Result<SpaceSeq>| SpaceMetrics::of_seq(scaled.as_ref().map_err(Clone::clone)?),
+        || run_method(m, input, options, unit_scale),
+    );
     let before = before?;
     let Ran {
         outcome,
