@@ -765,15 +765,21 @@ fn span_gram<const D: usize>(
             }
         });
     }
-    let mut gram = Vec::new();
-    for (k, v) in band.iter().enumerate() {
-        if *v != 0.0 {
+    band_entries(&band, dim, bw)
+}
+
+/// The non-zero entries `(r, c, v)` of a band array of `dim` rows of width `2bw + 1` (offsets
+/// `c − r` in `[−bw, bw]`, wrapped for closed curves; see [`offset`]), row by row.
+fn band_entries(band: &[f64], dim: usize, bw: usize) -> Vec<(usize, usize, f64)> {
+    let width = 2 * bw + 1;
+    band.iter()
+        .enumerate()
+        .filter(|(_, v)| **v != 0.0)
+        .map(|(k, v)| {
             let r = k / width;
-            let c = (r + dim + k % width - bw) % dim;
-            gram.push((r, c, *v));
-        }
-    }
-    gram
+            (r, (r + dim + k % width - bw) % dim, *v)
+        })
+        .collect()
 }
 
 /// `2 Bᵀ (c − B x_held)` over the free points, from the knot spans' sums: on a span
@@ -1192,12 +1198,7 @@ mod tests {
                     }
                 },
             );
-            let swept: Vec<(usize, usize, f64)> = band
-                .iter()
-                .enumerate()
-                .filter(|(_, v)| **v != 0.0)
-                .map(|(k, v)| (k / width, (k / width + dim + k % width - bw) % dim, *v))
-                .collect();
+            let swept = band_entries(&band, dim, bw);
             assert_eq!(span_gram(&map, &sums, &held), swept, "closed {closed}");
             let mut shifted = vec![0.0; 2 * n];
             design.eval_then::<2>(&fixed, &mut shifted, |i, q| {
