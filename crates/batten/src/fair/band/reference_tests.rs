@@ -467,10 +467,11 @@ fn spline_form_matches_clarabel() {
     check_spline(1600, true, Metric::Jerk, 48, false);
 }
 
-/// The round's check is asked once, when the gap falls below its threshold, and a `true`
-/// ends the run there, short of the stopping rule; `false` leaves the run as it was.
+/// The round's check is asked once for each of its thresholds the gap falls below, and a
+/// `true` ends the run there, short of the stopping rule; `false` leaves the run as it was.
 #[test]
-fn the_rounds_check_is_asked_once_and_ends_the_run() {
+fn the_rounds_check_is_asked_at_its_thresholds_and_ends_the_run() {
+    use super::solver::{CHECK_GAPS_REL, GAP_REL};
     let case = SplineCase::new(1500, false, Metric::Jerk, 40, false);
     let problem = case.problem();
     let plain = super::solver::solve_all(&problem).expect("solve");
@@ -480,19 +481,26 @@ fn the_rounds_check_is_asked_once_and_ends_the_run() {
         false
     })
     .expect("solve");
-    assert_eq!(asked, 1);
+    assert_eq!(asked, CHECK_GAPS_REL.len());
     assert_eq!(on.iterations, plain.iterations);
     assert_eq!(on.objective.to_bits(), plain.objective.to_bits());
-    let stopped = super::solver::solve_all_checked(&problem, |_| true).expect("solve");
-    assert!(plain.converged && !stopped.converged);
-    assert!(stopped.iterations < plain.iterations);
-    assert!(stopped.gap <= 1e-2 && stopped.gap > super::solver::GAP_REL);
-    assert!(
-        stopped
-            .r
-            .chunks(2)
-            .all(|r| r[0] * r[0] + r[1] * r[1] <= 1.0)
-    );
+    let inside =
+        |s: &super::solver::Solution| s.r.chunks(2).all(|r| r[0] * r[0] + r[1] * r[1] <= 1.0);
+    // Ended at the first check, then at the last one.
+    let first = super::solver::solve_all_checked(&problem, |_| true).expect("solve");
+    assert!(plain.converged && !first.converged);
+    assert!(first.iterations < plain.iterations);
+    assert!(first.gap <= CHECK_GAPS_REL[0] && first.gap > GAP_REL);
+    assert!(inside(&first));
+    let mut k = 0;
+    let last = super::solver::solve_all_checked(&problem, |_| {
+        k += 1;
+        k == asked
+    })
+    .expect("solve");
+    assert!(!last.converged && last.iterations < plain.iterations);
+    assert!(last.gap <= CHECK_GAPS_REL[1] && last.iterations > first.iterations);
+    assert!(inside(&last));
 }
 
 /// The spline form's data term from the knot spans' sums where a span's points share one
