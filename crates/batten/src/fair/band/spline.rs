@@ -108,11 +108,7 @@ fn spans_and_basis(
             .enumerate()
             .for_each(|(c, pair)| piece(c, pair));
     } else {
-        first
-            .chunks_mut(LAYOUT_PIECE)
-            .zip(basis.chunks_mut(LAYOUT_PIECE))
-            .enumerate()
-            .for_each(|(c, pair)| piece(c, pair));
+        piece(0, (&mut first, &mut basis));
     }
     (first, basis)
 }
