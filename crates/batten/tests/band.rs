@@ -602,24 +602,38 @@ proptest! {
 }
 
 /// Dense points with held tangents (10 000, noise about 16 spacings) take the point form,
-/// which rounding stops short of its
-/// stopping rule (docs/algorithms/band.md, Limits). The report says so — status `stalled`,
-/// not the iteration limit, with the gap in a note — and the tolerance holds.
+/// which rounding mostly stops short of its stopping rule (docs/algorithms/band.md, Limits).
+/// The report says so — status `stalled`, not the iteration limit, with the gap in a note —
+/// and the tolerance holds. Whether a given draw stalls is up to rounding (35 of 40 seeds
+/// did; seed 3 stalled until the noise estimate's lengths changed by an ulp), so three
+/// draws are run and at least one must stall.
 #[test]
 fn a_run_that_rounding_stops_is_reported_as_stalled_within_the_tolerance() {
-    let input = noisy(10_000, 0.01, 3, false);
-    let options = FairOptions::default().with_end_fix(EndFix::Tangent);
-    let out = fair::fair("band", &input, &options).expect("band runs");
-    let r = &out.report;
-    assert_eq!(r.status, FairStatus::Stalled, "{:?}", r.notes);
-    assert!(r.iterations < 200, "stopped by rounding, not the limit");
-    assert!(
-        r.notes.iter().any(|n| n.contains("stopped short")),
-        "{:?}",
-        r.notes
-    );
-    let d = r.tolerance.expect("auto tolerance");
-    assert!(r.tolerance_met && max_move(input.points(), &out.points) <= d);
+    let mut stalled = 0;
+    for seed in [0, 1, 2] {
+        let input = noisy(10_000, 0.01, seed, false);
+        let options = FairOptions::default().with_end_fix(EndFix::Tangent);
+        let out = fair::fair("band", &input, &options).expect("band runs");
+        let r = &out.report;
+        assert!(
+            matches!(r.status, FairStatus::Stalled | FairStatus::Converged),
+            "seed {seed}: {:?} {:?}",
+            r.status,
+            r.notes
+        );
+        assert!(r.iterations < 200, "stopped by rounding, not the limit");
+        let d = r.tolerance.expect("auto tolerance");
+        assert!(r.tolerance_met && max_move(input.points(), &out.points) <= d);
+        if r.status == FairStatus::Stalled {
+            stalled += 1;
+            assert!(
+                r.notes.iter().any(|n| n.contains("stopped short")),
+                "{:?}",
+                r.notes
+            );
+        }
+    }
+    assert!(stalled > 0, "none of the three draws stalled");
 }
 
 /// A 1000-point noisy clothoid (bench/quality.py's test case, 1 % noise, seed 3) on which the
