@@ -492,7 +492,7 @@ impl<'a> AnalysisSpans<'a> {
         let n = self.points.len();
         hermite_coeffs(
             self.points[i].to_vec2(),
-            self.points[(i + 1) % n].to_vec2(),
+            self.points[if i + 1 < n { i + 1 } else { 0 }].to_vec2(),
             self.tangents[i],
             self.tangents[i + 1],
             self.t[i + 1] - self.t[i],
@@ -739,14 +739,16 @@ pub fn displacement(a: &[Point], b: &[Point]) -> Result<Displacement> {
             expected: a.len(),
         });
     }
+    // The distances (a `hypot` each) in parallel on long sequences; the sum in order, so
+    // the same bits on any number of threads.
+    let distances = crate::numeric::map_indices(a.len(), |i| a[i].distance(b[i]));
     let mut d = Displacement {
         max: 0.0,
         argmax: 0,
         sum: 0.0,
-        moved: Vec::new(),
+        moved: Vec::with_capacity(distances.iter().filter(|&&v| v > 0.0).count()),
     };
-    for (i, (p, q)) in a.iter().zip(b).enumerate() {
-        let dist = p.distance(*q);
+    for (i, &dist) in distances.iter().enumerate() {
         d.sum += dist;
         if dist > d.max {
             d.max = dist;

@@ -36,7 +36,7 @@
 //! generic over the dimension, and the planar results are those it always gave.
 
 use crate::geom::Point;
-use crate::numeric::{PARALLEL_FROM, map_indices};
+use crate::numeric::{PARALLEL_FROM, map_indices, norm};
 
 /// The MAD-to-σ factor for Gaussian noise.
 pub const MAD_TO_SIGMA: f64 = 1.482_6;
@@ -135,32 +135,13 @@ pub(crate) fn is_planar(pts: &[[f64; 3]]) -> bool {
             normal[k] += sign * x[k];
         }
     }
-    let len = length(&normal);
+    let len = norm(&normal);
     if len == 0.0 {
         return true;
     }
     u.iter()
         .all(|q| ((0..3).map(|k| q[k] * normal[k]).sum::<f64>() / len).abs() <= PLANAR_REL)
 }
-
-/// `|a|`: `√(Σ a_k²)` where the sum of squares neither overflows nor comes near the
-/// underflow ([`SQUARES_SAFE_FROM`]), `hypot` otherwise. Both are within an ulp or so of the
-/// exact length; `hypot`, which scales its arguments to be safe everywhere, took a fifth of
-/// the noise estimate's time at 10⁶ points. A planar difference in space (`z = 0`) has the
-/// length of the 2-D one, bit for bit (the square of 0 adds nothing).
-fn length<const D: usize>(a: &[f64; D]) -> f64 {
-    let squares = a.iter().fold(0.0, |s, v| s + v * v);
-    if (SQUARES_SAFE_FROM..f64::INFINITY).contains(&squares) {
-        squares.sqrt()
-    } else {
-        (1..D).fold(a[0].abs(), |s, k| s.hypot(a[k]))
-    }
-}
-
-/// The smallest sum of squares [`length`] takes the square root of (`2⁻⁹⁰⁰`). Above it the
-/// sum is a normal number, and a component whose square underflows (below `2⁻¹⁰²²`) is
-/// shorter than the length by a factor `2⁻⁶¹` at least, so it would not change it.
-const SQUARES_SAFE_FROM: f64 = f64::from_bits((1023 - 900) << 52);
 
 /// `|d × c|`, the length of `d`'s part off `c` times `|c|`, by `hypot` (in 2-D the cross
 /// product's magnitude, bit for bit as [`crate::geom::Vec2::cross`]; in the plane `z = 0` of
@@ -221,12 +202,12 @@ impl<const D: usize> Differences<D> {
         // Each difference once (the rough scale and the normal parts both read it).
         let differences: Vec<[f64; D]> = map_indices(count, difference);
         let rough =
-            || median(&mut map_indices(count, |i| length(&differences[i]))) * MAD_TO_SIGMA / gain;
+            || median(&mut map_indices(count, |i| norm(&differences[i]))) * MAD_TO_SIGMA / gain;
         let spacing = || {
             median(&mut map_indices(if closed { n } else { n - 1 }, |i| {
                 // The point after `i` (a closed curve's last chord ends at the first).
                 let next = if i + 1 < n { pts[i + 1] } else { pts[0] };
-                length(&sub(next, pts[i]))
+                norm(&sub(next, pts[i]))
             }))
         };
         // The two medians side by side on long curves (a median is one thread's work).
@@ -395,7 +376,7 @@ impl<'p, const D: usize> NoiseMeasure<'p, D> {
         // to growing the vectors here).
         let part = |i: usize| {
             let chord = diffs.chord(pts, closed, i);
-            let len = length(&chord);
+            let len = norm(&chord);
             (len > 0.0).then(|| off_axis(&diffs.differences[i], &chord) / len)
         };
         let mut normal_parts = Vec::with_capacity(count);
@@ -414,11 +395,11 @@ impl<'p, const D: usize> NoiseMeasure<'p, D> {
         let (pts, closed) = (self.pts, self.closed);
         let diffs = self.diffs.as_ref()?;
         let count = diffs.differences.len();
-        // The unit chord by `length`, so that coordinates of any size neither over- nor
+        // The unit chord by `norm`, so that coordinates of any size neither over- nor
         // underflow.
         let part = |i: usize| -> [f64; D] {
             let c = diffs.chord(pts, closed, i);
-            let len = length(&c);
+            let len = norm(&c);
             let d = &diffs.differences[i];
             if !(len > 0.0 && len.is_finite()) {
                 return [0.0; D];
@@ -768,29 +749,6 @@ mod tests {
             );
             assert!(r < -0.5, "{r}");
         }
-    }
-
-    #[test]
-    fn length_is_hypot_within_an_ulp_at_any_scale() {
-        let e = gaussian(11, 4000);
-        let ulp = |v: f64| f64::from_bits(v.to_bits() + 1) - v;
-        for k in -320..=307 {
-            let s = 10f64.powi(k);
-            for w in e.chunks(2) {
-                let (x, y) = (w[0] * s, w[1] * s);
-                let exact = x.hypot(y);
-                let got = length(&[x, y]);
-                assert!(
-                    (got - exact).abs() <= ulp(exact),
-                    "{x:e} {y:e}: {got:e} vs {exact:e}"
-                );
-                // A planar vector in space has the planar length, bit for bit.
-                assert_eq!(length(&[x, y, 0.0]).to_bits(), got.to_bits());
-            }
-        }
-        assert_eq!(length(&[f64::MAX, f64::MAX]), f64::MAX.hypot(f64::MAX));
-        assert_eq!(length(&[3e-320, 4e-320]), 3e-320_f64.hypot(4e-320));
-        assert_eq!(length(&[0.0, -0.0]), 0.0);
     }
 
     #[test]

@@ -159,7 +159,7 @@ fn near_duplicates(points: &[Point], closed: bool) -> Result<()> {
     let n = points.len();
     let chords = if closed { n } else { n - 1 };
     for i in 0..chords {
-        let (a, c) = (points[i], points[(i + 1) % n]);
+        let (a, c) = (points[i], points[if i + 1 < n { i + 1 } else { 0 }]);
         let (dx, dy) = (half(c.x) - half(a.x), half(c.y) - half(a.y));
         // hypot(dx, dy) ≥ max(|dx|, |dy|), so a chord with either difference at the limit
         // passes without it (nearly every chord: the check costs a tenth of reading).

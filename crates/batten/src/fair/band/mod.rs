@@ -559,7 +559,7 @@ fn farthest<const D: usize>(shape: &[[f64; D]], pts: &[[f64; D]]) -> f64 {
 /// the points.
 fn parameter_window<const D: usize>(pts: &[[f64; D]], tolerance: f64) -> usize {
     let n = pts.len();
-    let mut chords: Vec<f64> = map_indices(n - 1, |i| distance(&pts[i], &pts[i + 1]));
+    let mut chords: Vec<f64> = map_indices(n - 1, |i| spacing(&pts[i], &pts[i + 1]));
     let mid = chords.len() / 2;
     let h = *chords.select_nth_unstable_by(mid, f64::total_cmp).1;
     if h > 0.0 {
@@ -583,7 +583,7 @@ fn dense_parameter_average<const D: usize>(
     let mut m = parameter_window(pts, tolerance);
     for _ in 0..DENSE_WINDOW_ROUNDS {
         let s = moving_average(pts, closed, m);
-        let mut chords: Vec<f64> = map_indices(n - 1, |i| distance(&s[i], &s[i + 1]));
+        let mut chords: Vec<f64> = map_indices(n - 1, |i| spacing(&s[i], &s[i + 1]));
         let mid = chords.len() / 2;
         let h = *chords.select_nth_unstable_by(mid, f64::total_cmp).1;
         if h <= 0.0 {
@@ -609,12 +609,15 @@ fn moving_average<const D: usize>(pts: &[[f64; D]], closed: bool, m: usize) -> V
     // prefix[j] = the sum of the first j points of the input, padded cyclically by m on each
     // side when closed.
     let pad = if closed { m } else { 0 };
-    let mut prefix = vec![[0.0; D]; n + 2 * pad + 1];
-    for j in 0..n + 2 * pad {
-        let p = &pts[(j + n - pad) % n];
+    let mut prefix = Vec::with_capacity(n + 2 * pad + 1);
+    let mut sum = [0.0; D];
+    prefix.push(sum);
+    // The last `pad` points, all of them, the first `pad` (pad ≤ n/8).
+    for p in pts[n - pad..].iter().chain(pts).chain(&pts[..pad]) {
         for a in 0..D {
-            prefix[j + 1][a] = prefix[j][a] + p[a];
+            sum[a] += p[a];
         }
+        prefix.push(sum);
     }
     map_indices(n, |i| {
         let (lo, hi) = if closed {
@@ -671,6 +674,12 @@ fn smoothed_for_parameters<const D: usize>(
             acc.map(|v| v / count)
         })
         .collect()
+}
+
+/// The distance between two points for a median spacing, which only chooses a window
+/// ([`crate::numeric::norm`]: faster than [`distance`], within an ulp of it).
+fn spacing<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
+    crate::numeric::norm::<D>(&std::array::from_fn(|k| a[k] - b[k]))
 }
 
 /// Euclidean distance, computed as the fairing contract measures displacement (`hypot`, in 2-D
