@@ -74,20 +74,29 @@ pub fn run(args: &FairArgs) -> Result<ExitCode, Failure> {
             fair::fair_curve(method.name(), curve, &options).map_err(failed)?,
             None,
         ),
-        Source::Points(d) => {
-            let stage = |pre: fair::Provisional<'_>| -> Option<io::Staged> {
+        // The scope joins the writing thread whatever happens, so that a staged file not
+        // kept is removed (its `Staged` dropped) before the command ends.
+        Source::Points(d) => std::thread::scope(|scope| {
+            let stage = |pre: fair::Provisional<'_>| {
                 if to_stdout {
                     return None;
                 }
                 let tangents = pre.tangents.or(d.tangents.as_deref());
                 let pts = (pre.points, pre.curve, d.seq.is_closed(), tangents);
                 let bytes = points_bytes(out_format, &out_name, pts, &origin).ok()?;
-                io::stage(&args.output, &bytes).ok()
+                // The write and its flush to disk (tens of milliseconds at 10⁶ points) on a
+                // thread of their own: on a worker of the thread pool, the wait for the disk
+                // would leave the measures that run meanwhile one core.
+                let output = &args.output;
+                Some(scope.spawn(move || io::stage(output, &bytes).ok()))
             };
             let (faired, staged, kept) =
                 fair::fair_with_beside(method, &d.seq, &options, stage).map_err(failed)?;
-            (faired, staged.filter(|_| kept))
-        }
+            let staged = staged
+                .filter(|_| kept)
+                .and_then(|writing| writing.join().ok().flatten());
+            Ok::<_, Failure>((faired, staged))
+        })?,
     };
     let data = match &source {
         Source::Points(d) => Some(d),
