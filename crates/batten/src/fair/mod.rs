@@ -824,15 +824,19 @@ fn finish<T: Send>(
             expected: input.len(),
         });
     }
-    let mut faired = input.with_points(outcome.points.clone())?;
-    let measure = || FairnessMetrics::of_seq(&in_unit(&faired, unit_scale));
+    // The result checked as a point sequence and measured, beside `beside`.
+    let measure = || -> Result<(PointSeq, FairnessMetrics)> {
+        let faired = input.with_points(outcome.points.clone())?;
+        let after = FairnessMetrics::of_seq(&in_unit(&faired, unit_scale))?;
+        Ok((faired, after))
+    };
     let provisional = Provisional {
         points: &outcome.points,
         curve: outcome.curve.as_ref(),
         tangents: outcome.tangents.as_deref(),
     };
-    let (after, side) = beside_if_long(input.len(), measure, || beside(provisional));
-    let mut after = after?;
+    let (measured, side) = beside_if_long(input.len(), measure, || beside(provisional));
+    let (mut faired, mut after) = measured?;
     let mut kept = true;
     if options.keep_clean
         && m.keeps_clean()
