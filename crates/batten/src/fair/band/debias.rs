@@ -638,8 +638,8 @@ fn smooth_log_weights(weights: &[f64], unit: f64, closed: bool, lengths: f64) ->
     let mut prefix = Vec::with_capacity(3 * n + 1);
     prefix.push(0.0);
     let mut acc = 0.0;
-    for k in 0..3 * n {
-        acc += logs[k % n];
+    for l in logs.iter().chain(&logs).chain(&logs) {
+        acc += l;
         prefix.push(acc);
     }
     map_indices(n, |i| {
