@@ -20,7 +20,7 @@
 //! tolerance, or an output could not be written.
 //!
 //! Here: the arguments and the run (checks, thread pool, progress, conclusion). The checks
-//! before any work are in [`plan`], one point file in [`file`], a DXF file in [`dxf`], the
+//! before any work are in [`plan`], one point file in [`mod@file`], a DXF file in [`dxf`], the
 //! summary's rows and files (also when interrupted) in [`summary`].
 
 mod dxf;

@@ -317,7 +317,7 @@ impl Split {
 
 impl SymBanded {
     /// [`SymBanded::factorize`], from both ends at once on two threads when the matrix has
-    /// [`SPLIT_FROM`] rows or more and a half-bandwidth of 7 or 11 (`band`'s; see the
+    /// `SPLIT_FROM` (16 384) rows or more and a half-bandwidth of 7 or 11 (`band`'s; see the
     /// module's documentation): the same matrix's factors in another elimination order, in
     /// place, for [`SymBanded::solve_in_place`] only (not [`SymBanded::l`] and
     /// [`SymBanded::d`]).
