@@ -33,7 +33,7 @@
 //! In space ([`noise_sigma_space`]) the part of a difference off the local chord is 2-D; its
 //! length's median, `σ·√C(2k, k)·√(2 ln 2)` for Gaussian noise, gives the first σ̂, and the
 //! clipped mean square of the lengths (Rayleigh-distributed) the rest. The code is one,
-//! generic over the dimension, and the planar results are those it always gave.
+//! generic over the dimension, and a planar curve in space gives the planar results.
 
 use crate::geom::Point;
 use crate::numeric::{PARALLEL_FROM, map_indices, norm};
@@ -409,8 +409,8 @@ impl<'p, const D: usize> NoiseMeasure<'p, D> {
             std::array::from_fn(|x| d[x] - along * u[x])
         };
         // In units of the largest part, so that no square under- or overflows. The parts are
-        // formed again for the sums rather than stored (16 bytes a point, and the pages'
-        // first touch cost as much as the sums).
+        // formed again for the sums rather than stored and divided once per product they
+        // enter (with the sums in parallel, 22 → 13 ms at 10⁶ points).
         let largest = |i: usize| part(i).iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let top = if count >= PARALLEL_FROM {
             use rayon::prelude::*;
