@@ -492,7 +492,7 @@ impl<'a> AnalysisSpans<'a> {
         let n = self.points.len();
         hermite_coeffs(
             self.points[i].to_vec2(),
-            self.points[if i + 1 < n { i + 1 } else { 0 }].to_vec2(),
+            self.points[crate::geom::next_index(i, n)].to_vec2(),
             self.tangents[i],
             self.tangents[i + 1],
             self.t[i + 1] - self.t[i],

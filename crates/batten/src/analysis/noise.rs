@@ -35,7 +35,7 @@
 //! clipped mean square of the lengths (Rayleigh-distributed) the rest. The code is one,
 //! generic over the dimension, and a planar curve in space gives the planar results.
 
-use crate::geom::Point;
+use crate::geom::{Point, next_index};
 use crate::numeric::{PARALLEL_FROM, map_indices, norm};
 
 /// The MAD-to-σ factor for Gaussian noise.
@@ -205,9 +205,8 @@ impl<const D: usize> Differences<D> {
             || median(&mut map_indices(count, |i| norm(&differences[i]))) * MAD_TO_SIGMA / gain;
         let spacing = || {
             median(&mut map_indices(if closed { n } else { n - 1 }, |i| {
-                // The point after `i` (a closed curve's last chord ends at the first).
-                let next = if i + 1 < n { pts[i + 1] } else { pts[0] };
-                norm(&sub(next, pts[i]))
+                // A closed curve's last chord ends at the first point.
+                norm(&sub(pts[next_index(i, n)], pts[i]))
             }))
         };
         // The two medians side by side on long curves (a median is one thread's work).
@@ -445,7 +444,7 @@ impl<'p, const D: usize> NoiseMeasure<'p, D> {
             }
             // The pair across the chunk's end (the last with the first on a closed curve).
             if end - 1 < pairs {
-                lagged += dot(&prev, &scaled(if end < count { end } else { 0 }));
+                lagged += dot(&prev, &scaled(next_index(end - 1, count)));
             }
             (lagged, total)
         };

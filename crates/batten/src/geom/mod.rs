@@ -16,6 +16,7 @@ mod transform;
 pub use ends::EndFix;
 pub use point::{BBox, Point, Vec2, max_abs_coordinate};
 pub use scale::{pow2, scale_points, unit_scale, unit_scale_xyz};
+pub(crate) use seq::next_index;
 pub use seq::{NEAR_DUPLICATE_REL, PointSeq};
 pub use space::{SpaceSeq, Xyz};
 #[allow(unused_imports)]

@@ -137,6 +137,14 @@ pub(crate) fn validate_points(points: &[Point], closed: bool, min: usize) -> Res
     near_duplicates(points, closed)
 }
 
+/// The index after `i` on a closed sequence of `n` items (`0` after the last): `(i + 1) % n`
+/// for `i < n` by a comparison, not a division (it runs once a point in the sweeps over
+/// 10⁶-point curves).
+#[inline]
+pub(crate) fn next_index(i: usize, n: usize) -> usize {
+    if i + 1 < n { i + 1 } else { 0 }
+}
+
 /// Consecutive points closer than this fraction of the larger side of the bounding box are
 /// refused as near-duplicates ([`Error::NearDuplicate`]). Coordinates of magnitude R carry a
 /// rounding of about 10⁻¹⁶·R, so a chord of 10⁻¹² of the curve's size has its length and
@@ -159,7 +167,7 @@ fn near_duplicates(points: &[Point], closed: bool) -> Result<()> {
     let n = points.len();
     let chords = if closed { n } else { n - 1 };
     for i in 0..chords {
-        let (a, c) = (points[i], points[if i + 1 < n { i + 1 } else { 0 }]);
+        let (a, c) = (points[i], points[next_index(i, n)]);
         let (dx, dy) = (half(c.x) - half(a.x), half(c.y) - half(a.y));
         // hypot(dx, dy) ≥ max(|dx|, |dy|), so a chord with either difference at the limit
         // passes without it (nearly every chord: the check costs a tenth of reading).

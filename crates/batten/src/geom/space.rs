@@ -134,7 +134,7 @@ fn near_duplicates(points: &[Xyz], closed: bool) -> Result<()> {
     let n = points.len();
     let chords = if closed { n } else { n - 1 };
     for i in 0..chords {
-        let (a, c) = (points[i], points[if i + 1 < n { i + 1 } else { 0 }]);
+        let (a, c) = (points[i], points[super::next_index(i, n)]);
         let d = norm(std::array::from_fn(|k| half(c[k]) - half(a[k])));
         if d < limit {
             return Err(Error::NearDuplicate {

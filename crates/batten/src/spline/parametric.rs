@@ -51,7 +51,7 @@ pub fn parameters(points: &[Point], kind: Parametrization, closed: bool) -> Resu
     // The chord lengths (hypot, the costly part) in parallel for long sequences, then summed
     // in order: the same bits with any number of threads.
     let lengths = map_indices(m, |i| {
-        (points[if i + 1 < n { i + 1 } else { 0 }] - points[i]).length()
+        (points[crate::geom::next_index(i, n)] - points[i]).length()
     });
     let mut t = Vec::with_capacity(m + 1);
     t.push(0.0);
@@ -307,7 +307,7 @@ pub(crate) fn c2_closed_tangents(
     let t = parameters(points, param, true)?;
     let dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect(); // n spans
     let slope: Vec<Vec2> = (0..n)
-        .map(|i| (points[if i + 1 < n { i + 1 } else { 0 }] - points[i]) / dt[i])
+        .map(|i| (points[crate::geom::next_index(i, n)] - points[i]) / dt[i])
         .collect();
     let mut tangents = periodic_tangents(&dt, &slope)?;
     tangents.push(tangents[0]);

@@ -80,7 +80,7 @@ pub(super) fn four_from(first: usize, n: usize) -> [usize; 4] {
 pub(super) fn chords_of<const D: usize>(shape: &[[f64; D]], closed: bool) -> Vec<f64> {
     let n = shape.len();
     map_indices(if closed { n } else { n - 1 }, |i| {
-        super::distance(&shape[i], &shape[if i + 1 < n { i + 1 } else { 0 }])
+        super::distance(&shape[i], &shape[crate::geom::next_index(i, n)])
     })
 }
 

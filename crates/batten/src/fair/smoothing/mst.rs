@@ -133,8 +133,8 @@ fn chord_parameters(points: &[Xyz], closed: bool) -> Vec<f64> {
     let spans = if closed { n } else { n - 1 };
     let mut t = vec![0.0; spans + 1];
     for i in 0..spans {
-        t[i + 1] = t[i]
-            + crate::fair::space::distance(&points[if i + 1 < n { i + 1 } else { 0 }], &points[i]);
+        t[i + 1] =
+            t[i] + crate::fair::space::distance(&points[crate::geom::next_index(i, n)], &points[i]);
     }
     t
 }
