@@ -20,6 +20,26 @@ pub(crate) fn map_indices<T: Send>(count: usize, f: impl Fn(usize) -> T + Sync +
     }
 }
 
+/// The largest of `f(0), …, f(count − 1)` and 0 (NaNs ignored), in parallel from
+/// [`PARALLEL_FROM`] elements on (in pieces of at least `piece`): the largest is the same in
+/// any order, so the same with any number of threads.
+pub(crate) fn max_indices(
+    count: usize,
+    piece: usize,
+    f: impl Fn(usize) -> f64 + Sync + Send,
+) -> f64 {
+    use rayon::prelude::*;
+    if count >= PARALLEL_FROM {
+        (0..count)
+            .into_par_iter()
+            .with_min_len(piece)
+            .map(f)
+            .reduce(|| 0.0, f64::max)
+    } else {
+        (0..count).map(f).fold(0.0, f64::max)
+    }
+}
+
 /// `background(&data)` and `foreground()` side by side, `background` on threads of the
 /// lowest scheduling priority (on Linux `SCHED_IDLE`: it runs only on a core nothing else
 /// wants), `foreground` on the thread pool. For work a long computation does not need until

@@ -121,11 +121,11 @@ impl<const D: usize> Form<D> {
         self.design.vars()
     }
 
-    /// The first pass's reference, in the solver's units: the points `smoothed` (flat) in
-    /// the point form, the feasible start in the spline form.
-    pub(super) fn first_reference(&self, smoothed: Vec<f64>) -> Vec<f64> {
+    /// The first pass's reference, in the solver's units: the points `smoothed()` gives
+    /// (flat) in the point form, the feasible start in the spline form.
+    pub(super) fn first_reference(&self, smoothed: impl FnOnce() -> Vec<f64>) -> Vec<f64> {
         match &self.kind {
-            Kind::Points { .. } => smoothed,
+            Kind::Points { .. } => smoothed(),
             Kind::Spline { fit, .. } => fit.clone(),
         }
     }

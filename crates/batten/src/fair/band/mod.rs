@@ -69,7 +69,7 @@ use crate::fair::{
     SolverInfo, SpaceOutcome,
 };
 use crate::geom::{Point, PointSeq, SpaceSeq};
-use crate::numeric::map_indices;
+use crate::numeric::{map_indices, max_indices};
 
 use debias::{ENERGY_CAP, Penalized};
 use energy::{Energy, Metric};
@@ -342,7 +342,12 @@ fn fair_points<const D: usize>(
     };
     let spline_form = spline.is_some();
     let form = spline.unwrap_or_else(|| Form::points(held, chords, closed));
-    let mut reference = form.first_reference(shape.iter().flat_map(scale).collect());
+    let mut reference = form.first_reference(|| shape.iter().flat_map(scale).collect());
+    if spline_form {
+        // Its energy takes its tangents from the control points: the averaged points are
+        // done with.
+        shape = Vec::new();
+    }
     let mut stages = Stages {
         pts,
         tolerance,
@@ -353,6 +358,11 @@ fn fair_points<const D: usize>(
         stalled: None,
         gap: 0.0,
     };
+    // The last stage's displacements, put into the band at the end. The point form's energy
+    // takes its tangents from the points, so there `shape` follows every stage; the spline
+    // form's takes them from its control points, and putting a million points into the band
+    // after every stage only to measure them cost about 8 ms a stage.
+    let mut last = Vec::new();
     for pass in 0..params.passes {
         let energy = form.energy(&shape, &reference, pass_metric(pass, params));
         // A pass before the last gives only the next pass's reference: a looser stopping rule.
@@ -364,8 +374,12 @@ fn fair_points<const D: usize>(
         let limits = (params.max_iterations, gap_rel);
         let problem = band_problem(&form, &energy, &reference, &scaled, limits);
         let sol = solve(&problem)?;
-        stages.record(&sol, pass + 1, &mut shape);
+        stages.record(&sol, pass + 1);
+        if !spline_form {
+            shape = into_band(pts, &sol.r, tolerance);
+        }
         reference = form.next_reference(&reference, &scaled, &sol);
+        last = sol.r;
     }
     let mut fidelity = None;
     if params.fit > 0.0 && noise_sigma > 0.0 {
@@ -373,11 +387,13 @@ fn fair_points<const D: usize>(
         if let Some((sol, mu, raised)) =
             debias_stage(&form, &shape, &reference, &scaled, tolerance, noise, params)?
         {
-            stages.record(&sol, params.passes + 1, &mut shape);
+            stages.record(&sol, params.passes + 1);
+            last = sol.r;
             // Reported in the point form's units.
             fidelity = Some((mu / form.unit(), raised));
         }
     }
+    let shape = into_band(pts, &last, tolerance);
     let edge = (1.0 - BAND_EDGE_REL) * tolerance;
     let on_edge = map_indices(n, |i| distance(&shape[i], &pts[i]) >= edge)
         .into_iter()
@@ -428,9 +444,9 @@ struct Stages<'p, const D: usize> {
 }
 
 impl<const D: usize> Stages<'_, D> {
-    /// Each stage: one solve from the current reference, the result put into the band, a
-    /// history row (`stage` counts from 1: the passes, then the debiasing stage).
-    fn record(&mut self, sol: &solver::Solution, stage: usize, shape: &mut Vec<[f64; D]>) {
+    /// Each stage: one solve from the current reference, a history row with its result put
+    /// into the band (`stage` counts from 1: the passes, then the debiasing stage).
+    fn record(&mut self, sol: &solver::Solution, stage: usize) {
         self.iterations += sol.iterations;
         self.converged &= sol.converged;
         if !sol.converged && sol.iterations < self.max_iterations {
@@ -438,11 +454,10 @@ impl<const D: usize> Stages<'_, D> {
             self.stalled = Some(self.stalled.map_or(sol.gap, |g: f64| g.max(sol.gap)));
         }
         self.gap = sol.gap;
-        *shape = into_band(self.pts, &sol.r, self.tolerance);
         self.history.push(HistoryRow {
             iteration: stage,
             measure: sol.objective,
-            max_distance: farthest(shape, self.pts),
+            max_distance: farthest(self.pts, &sol.r, self.tolerance),
         });
     }
 }
@@ -535,24 +550,29 @@ fn band_problem<'a, const D: usize>(
     }
 }
 
-/// The largest distance of a point of `shape` from its input point, by [`distance`]: the
-/// squared distances pick the candidates (within rounding of the largest), which are then
-/// measured exactly.
-fn farthest<const D: usize>(shape: &[[f64; D]], pts: &[[f64; D]]) -> f64 {
-    let square = |q: &[f64; D], p: &[f64; D]| (0..D).map(|a| (q[a] - p[a]).powi(2)).sum::<f64>();
-    let top = shape
-        .iter()
-        .zip(pts)
-        .map(|(q, p)| square(q, p))
-        .fold(0.0_f64, f64::max);
-    let near = top * (1.0 - 1e-12);
-    shape
-        .iter()
-        .zip(pts)
-        .filter(|(q, p)| square(q, p) >= near)
-        .map(|(q, p)| distance(q, p))
-        .fold(0.0_f64, f64::max)
+/// The largest distance of a point put into the band ([`into_band_point`] of the
+/// displacements `r`) from its input point, by [`distance`]: the squared distances pick the
+/// candidates (within rounding of the largest), which are then measured exactly. In
+/// parallel pieces; the largest is the same in any order.
+fn farthest<const D: usize>(pts: &[[f64; D]], r: &[f64], tolerance: f64) -> f64 {
+    let point = |i: usize| into_band_point(&pts[i], &r[i * D..(i + 1) * D], tolerance);
+    let square = |i: usize| {
+        let q = point(i);
+        (0..D).map(|a| (q[a] - pts[i][a]).powi(2)).sum::<f64>()
+    };
+    let n = pts.len();
+    let near = max_indices(n, FARTHEST_PIECE, square) * (1.0 - 1e-12);
+    max_indices(n, FARTHEST_PIECE, |i| {
+        if square(i) >= near {
+            distance(&point(i), &pts[i])
+        } else {
+            0.0
+        }
+    })
 }
+
+/// The least piece of [`farthest`]'s parallel sweeps.
+const FARTHEST_PIECE: usize = 4096;
 
 /// The half-width `m` of the parameter window: `⌊c·D / h⌋`, `c` =
 /// [`PARAMETER_WINDOW_TOLERANCES`], `h` the median chord of the input, at most an eighth of
@@ -695,32 +715,35 @@ fn distance<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
 /// longer, then shortened by a cut that starts at a few units in the last place and doubles.
 fn into_band<const D: usize>(pts: &[[f64; D]], r: &[f64], tolerance: f64) -> Vec<[f64; D]> {
     map_indices(pts.len(), |i| {
-        let p = &pts[i];
-        let ri = &r[i * D..(i + 1) * D];
-        let len = ri.iter().map(|v| v * v).sum::<f64>().sqrt();
-        // Clearly inside, rounding of `q` and of its distance included (a few units in
-        // the last place of the coordinates and of `D`; 16 of them here): no check needed.
-        let size = p.iter().fold(tolerance, |m, v| m.max(v.abs()));
-        if len <= 1.0 - 16.0 * f64::EPSILON * (1.0 + size / tolerance) {
-            return std::array::from_fn(|a| p[a] + tolerance * ri[a]);
-        }
-        let mut shrink = if len > 1.0 { 1.0 / len } else { 1.0 };
-        // Far from the origin the rounding of `q` is large against `D`: the cut doubles
-        // at each try, from 4 units in the last place.
-        let mut cut = 4.0 * f64::EPSILON;
-        for _ in 0..MAX_SHRINKS {
-            let mut q = *p;
-            for a in 0..D {
-                q[a] = p[a] + tolerance * (shrink * ri[a]);
-            }
-            if distance(&q, p) <= tolerance {
-                return q;
-            }
-            shrink *= 1.0 - cut;
-            cut = (2.0 * cut).min(1.0);
-        }
-        *p
+        into_band_point(&pts[i], &r[i * D..(i + 1) * D], tolerance)
     })
+}
+
+/// Point `p` of [`into_band`], displaced by `ri` (in tolerances).
+fn into_band_point<const D: usize>(p: &[f64; D], ri: &[f64], tolerance: f64) -> [f64; D] {
+    let len = ri.iter().map(|v| v * v).sum::<f64>().sqrt();
+    // Clearly inside, rounding of `q` and of its distance included (a few units in
+    // the last place of the coordinates and of `D`; 16 of them here): no check needed.
+    let size = p.iter().fold(tolerance, |m, v| m.max(v.abs()));
+    if len <= 1.0 - 16.0 * f64::EPSILON * (1.0 + size / tolerance) {
+        return std::array::from_fn(|a| p[a] + tolerance * ri[a]);
+    }
+    let mut shrink = if len > 1.0 { 1.0 / len } else { 1.0 };
+    // Far from the origin the rounding of `q` is large against `D`: the cut doubles
+    // at each try, from 4 units in the last place.
+    let mut cut = 4.0 * f64::EPSILON;
+    for _ in 0..MAX_SHRINKS {
+        let mut q = *p;
+        for a in 0..D {
+            q[a] = p[a] + tolerance * (shrink * ri[a]);
+        }
+        if distance(&q, p) <= tolerance {
+            return q;
+        }
+        shrink *= 1.0 - cut;
+        cut = (2.0 * cut).min(1.0);
+    }
+    *p
 }
 
 #[cfg(test)]

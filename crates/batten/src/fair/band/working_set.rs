@@ -73,8 +73,6 @@ pub(super) fn solve<const D: usize>(
     let mut y_start = start.to_vec();
     let mut iterations = 0;
     let mut r = vec![0.0; n * D];
-    let mut r0 = vec![0.0; n * D];
-    p.design.residual::<D>(start, &p.centres, None, &mut r0);
     for _ in 0..MAX_ROUNDS {
         let set: Vec<usize> = (0..n).filter(|&i| in_set[i]).collect();
         let design = Design::Spline(SplineMap {
@@ -118,10 +116,14 @@ pub(super) fn solve<const D: usize>(
         let outside =
             (0..n).any(|i| !in_set[i] && !p.pinned[i] && norm2(&r[i * D..(i + 1) * D]) > 1.0);
         if !outside {
-            let mut multipliers = vec![0.0; n];
-            for (k, &i) in set.iter().enumerate() {
-                multipliers[i] = sol.multipliers[k];
-            }
+            #[cfg(test)]
+            let multipliers = {
+                let mut all = vec![0.0; n];
+                for (k, &i) in set.iter().enumerate() {
+                    all[i] = sol.multipliers[k];
+                }
+                all
+            };
             return Ok(Solution {
                 r,
                 y: sol.y,
@@ -129,6 +131,7 @@ pub(super) fn solve<const D: usize>(
                 iterations,
                 gap: sol.gap,
                 converged: sol.converged,
+                #[cfg(test)]
                 multipliers,
             });
         }
@@ -141,11 +144,13 @@ pub(super) fn solve<const D: usize>(
                 continue;
             }
             in_set[i] = true;
-            let a = &r0[i * D..(i + 1) * D];
-            let d: Vec<f64> = (0..D).map(|k| ri[k] - a[k]).collect();
-            let a2 = norm2(a);
+            // The point's residual at the start (the same sums as a sweep's).
+            let q = p.design.value::<D>(i, start);
+            let a: [f64; D] = std::array::from_fn(|k| q[k] - p.centres[i * D + k]);
+            let d: [f64; D] = std::array::from_fn(|k| ri[k] - a[k]);
+            let a2 = norm2(&a);
             let radius2 = (RESTART_RADIUS * RESTART_RADIUS).max(0.5 * (a2 + 1.0));
-            theta = theta.min(segment_exit(a, &d, radius2));
+            theta = theta.min(segment_exit(&a, &d, radius2));
         }
         for (y, (s, x)) in y_start.iter_mut().zip(start.iter().zip(&sol.y)) {
             *y = s + theta * (x - s);
