@@ -305,6 +305,26 @@ impl Design {
         }
     }
 
+    /// Whether `test(i, (B x)_i)` holds at some point `i`: the sweep of
+    /// [`Design::eval_then`] without its output, in parallel pieces that stop once one is
+    /// found (a check that only asks whether any point is outside its ball writes no vector
+    /// of every point).
+    pub(super) fn any_point<const D: usize>(
+        &self,
+        x: &[f64],
+        test: impl Fn(usize, [f64; D]) -> bool + Sync,
+    ) -> bool {
+        let n = self.points();
+        match self {
+            Design::Points { .. } => (0..n).any(|i| test(i, std::array::from_fn(|a| x[i * D + a]))),
+            Design::Spline(s) => (0..n.div_ceil(EVAL_CHUNK)).into_par_iter().any(|c| {
+                let from = c * EVAL_CHUNK;
+                let to = (from + EVAL_CHUNK).min(n);
+                (from..to).any(|i| test(i, s.point_at::<D>(s.first[i], &s.basis[i], x)))
+            }),
+        }
+    }
+
     /// `out += Bᵀ r`.
     pub(super) fn eval_t_add<const D: usize>(&self, r: &[f64], out: &mut [f64]) {
         match self {
@@ -666,5 +686,29 @@ pub(super) mod tests {
                 assert!((g - w).abs() < 1e-14, "{g} {w}");
             }
         }
+    }
+
+    /// `any_point` finds a point exactly when the sweep's values do: on a long map (many
+    /// parallel pieces), for a point in the first piece, one in the last, none, and the
+    /// point form.
+    #[test]
+    fn any_point_agrees_with_the_sweep() {
+        let design = Design::Spline(long_map(3 * EVAL_CHUNK + 77, 2000));
+        let n = design.points();
+        let x: Vec<f64> = (0..2 * design.vars())
+            .map(|k| (k as f64 * 0.7).sin())
+            .collect();
+        let mut values = vec![0.0; 2 * n];
+        design.eval::<2>(&x, &mut values);
+        for target in [Some(5), Some(n - 1), None] {
+            let found = design.any_point::<2>(&x, |i, q| {
+                Some(i) == target && q[0] == values[2 * i] && q[1] == values[2 * i + 1]
+            });
+            assert_eq!(found, target.is_some(), "{target:?}");
+        }
+        let points = Design::Points { n: 4 };
+        let x = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0];
+        assert!(points.any_point::<2>(&x, |i, q| i == 2 && q == [4.0, 5.0]));
+        assert!(!points.any_point::<2>(&x, |_, q| q[0] > 6.0));
     }
 }

@@ -69,7 +69,8 @@ use crate::fair::{
     SolverInfo, SpaceOutcome,
 };
 use crate::geom::{Point, PointSeq, SpaceSeq};
-use crate::numeric::{map_indices, max_indices};
+use crate::numeric::{PARALLEL_FROM, map_indices};
+use rayon::prelude::*;
 
 use debias::{ENERGY_CAP, Penalized};
 use energy::{Energy, Metric};
@@ -552,27 +553,46 @@ fn band_problem<'a, const D: usize>(
 
 /// The largest distance of a point put into the band ([`into_band_point`] of the
 /// displacements `r`) from its input point, by [`distance`]: the squared distances pick the
-/// candidates (within rounding of the largest), which are then measured exactly. In
-/// parallel pieces; the largest is the same in any order.
+/// candidates (within rounding of the largest), which are then measured exactly.
+///
+/// One sweep, in parallel pieces: each piece measures the points whose square is within
+/// rounding of the largest so far in the piece, a superset of the candidates (that largest is
+/// at most the overall one), and the candidates are those of them within rounding of the
+/// overall largest. The same candidates, so the same number, in any number of pieces.
 fn farthest<const D: usize>(pts: &[[f64; D]], r: &[f64], tolerance: f64) -> f64 {
-    let point = |i: usize| into_band_point(&pts[i], &r[i * D..(i + 1) * D], tolerance);
-    let square = |i: usize| {
-        let q = point(i);
-        (0..D).map(|a| (q[a] - pts[i][a]).powi(2)).sum::<f64>()
-    };
-    let n = pts.len();
-    let near = max_indices(n, FARTHEST_PIECE, square) * (1.0 - 1e-12);
-    max_indices(n, FARTHEST_PIECE, |i| {
-        if square(i) >= near {
-            distance(&point(i), &pts[i])
-        } else {
-            0.0
+    const NEAR: f64 = 1.0 - 1e-12;
+    let piece = |c: usize| {
+        let mut top = 0.0_f64;
+        let mut measured = Vec::new();
+        for i in c * FARTHEST_PIECE..((c + 1) * FARTHEST_PIECE).min(pts.len()) {
+            let (p, q) = (
+                &pts[i],
+                into_band_point(&pts[i], &r[i * D..(i + 1) * D], tolerance),
+            );
+            let square = (0..D).map(|a| (q[a] - p[a]).powi(2)).sum::<f64>();
+            if square >= top * NEAR {
+                top = top.max(square);
+                measured.push((square, distance(&q, p)));
+            }
         }
-    })
+        (top, measured)
+    };
+    let pieces = pts.len().div_ceil(FARTHEST_PIECE);
+    let parts: Vec<(f64, Vec<(f64, f64)>)> = if pts.len() >= PARALLEL_FROM {
+        (0..pieces).into_par_iter().map(piece).collect()
+    } else {
+        (0..pieces).map(piece).collect()
+    };
+    let near = parts.iter().fold(0.0_f64, |m, (top, _)| m.max(*top)) * NEAR;
+    parts
+        .iter()
+        .flat_map(|(_, measured)| measured)
+        .filter(|(square, _)| *square >= near)
+        .fold(0.0_f64, |m, (_, d)| m.max(*d))
 }
 
-/// The least piece of [`farthest`]'s parallel sweeps.
-const FARTHEST_PIECE: usize = 4096;
+/// The points of a piece of [`farthest`]'s sweep.
+const FARTHEST_PIECE: usize = 1 << 14;
 
 /// The half-width `m` of the parameter window: `⌊c·D / h⌋`, `c` =
 /// [`PARAMETER_WINDOW_TOLERANCES`], `h` the median chord of the input, at most an eighth of
@@ -748,8 +768,9 @@ fn into_band_point<const D: usize>(p: &[f64; D], ri: &[f64], tolerance: f64) -> 
 
 #[cfg(test)]
 mod into_band_tests {
-    use super::into_band;
+    use super::{distance, farthest, into_band};
     use crate::Point;
+    use crate::numeric::PARALLEL_FROM;
 
     /// Points pushed to the band's edge in every direction, at scales where rounding matters,
     /// stay inside it by the contract's own measure (`Point::distance`, a `hypot`). A square
@@ -772,6 +793,54 @@ mod into_band_tests {
             let q = into_band(&[p], &r, tolerance)[0];
             let d = Point::new(p[0], p[1]).distance(Point::new(q[0], q[1]));
             assert!(d <= tolerance, "{d} > {tolerance} at {p:?}");
+        }
+    }
+
+    /// The farthest point of one sweep is that of the two sweeps over the points put into
+    /// the band (the largest square, then the exact distances of those within rounding of
+    /// it), on runs long enough to be cut into parallel pieces, with displacements growing,
+    /// shrinking and at the band's edge, where rounding makes the candidates many.
+    #[test]
+    fn farthest_is_the_largest_distance_of_the_points_put_into_the_band() {
+        let n = 2 * PARALLEL_FROM + 123;
+        let pts: Vec<[f64; 2]> = (0..n)
+            .map(|i| {
+                let t = i as f64 * 1e-3;
+                [1e3 * t.cos(), 7e2 * t.sin() + 3.0]
+            })
+            .collect();
+        let tolerance = 0.05;
+        let shapes: [&dyn Fn(usize) -> f64; 4] = [
+            &|i| i as f64 / n as f64,
+            &|i| 1.0 - i as f64 / n as f64,
+            &|i| 0.5 + 0.5 * (i as f64 * 0.37).sin(),
+            &|i| {
+                if i % 3 == 0 {
+                    1.0
+                } else {
+                    1.0 - 1e-15 * (i % 7) as f64
+                }
+            },
+        ];
+        for length in shapes {
+            let r: Vec<f64> = (0..n)
+                .flat_map(|i| {
+                    let a = i as f64 * 0.011;
+                    [length(i) * a.cos(), length(i) * a.sin()]
+                })
+                .collect();
+            let shape = into_band(&pts, &r, tolerance);
+            let square = |i: usize| {
+                (0..2)
+                    .map(|a| (shape[i][a] - pts[i][a]).powi(2))
+                    .sum::<f64>()
+            };
+            let top = (0..n).map(square).fold(0.0_f64, f64::max);
+            let expected = (0..n)
+                .filter(|&i| square(i) >= top * (1.0 - 1e-12))
+                .map(|i| distance(&shape[i], &pts[i]))
+                .fold(0.0_f64, f64::max);
+            assert_eq!(farthest(&pts, &r, tolerance).to_bits(), expected.to_bits());
         }
     }
 }

@@ -104,11 +104,11 @@ pub(super) fn solve<const D: usize>(
         // 1/[`CHECK_SET_FRACTION`] of them, whose iterations cost more, is checked.
         let check = set.len() * CHECK_SET_FRACTION >= n;
         let sol = solve_all_checked(&sub, |y| {
-            check && {
-                p.design
-                    .residual::<D>(y, &p.centres, Some(p.pinned), &mut r);
-                (0..n).any(|i| !in_set[i] && norm2(&r[i * D..(i + 1) * D]) > 1.0)
-            }
+            check
+                && p.design.any_point::<D>(y, |i, q| {
+                    let r: [f64; D] = std::array::from_fn(|a| q[a] - p.centres[i * D + a]);
+                    !in_set[i] && !p.pinned[i] && norm2(&r) > 1.0
+                })
         })?;
         iterations += sol.iterations;
         p.design
