@@ -563,6 +563,7 @@ impl<'a, const D: usize> Penalized<'a, D> {
         let mut windows = Windows::<D>::empty(closed);
         let mut marked = vec![0; n];
         let mut raise = Marks::new(n, closed);
+        let mut trial = Vec::with_capacity(n);
         for _ in 0..LOCAL_ROUNDS {
             // The residual (zero at held points, which the minimiser leaves at their centres).
             self.residual_into(&y, &mut flat);
@@ -577,24 +578,21 @@ impl<'a, const D: usize> Penalized<'a, D> {
                     raise.mark(i, half);
                 }
             }
-            let trial: Vec<f64> = weights
-                .iter()
-                .zip(raise.marked())
-                .map(|(w, r)| {
-                    if r {
-                        (w * LOCAL_FACTOR).min(self.unit)
-                    } else {
-                        *w
-                    }
-                })
-                .collect();
+            trial.clear();
+            trial.extend(weights.iter().zip(raise.marked()).map(|(w, r)| {
+                if r {
+                    (w * LOCAL_FACTOR).min(self.unit)
+                } else {
+                    *w
+                }
+            }));
             let Ok(trial_y) = self.minimiser(|i| trial[i], false) else {
                 break;
             };
             if self.energy_at(&trial_y, anchor_energy) > cap {
                 break;
             }
-            weights = trial;
+            std::mem::swap(&mut weights, &mut trial);
             y = trial_y;
         }
         if weights.iter().any(|w| *w > mu) {

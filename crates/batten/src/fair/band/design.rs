@@ -67,7 +67,7 @@ impl SplineMap {
 
     /// Cuts of the points into pieces of about `size`, each cut where a knot span begins
     /// (`first` changes), from 0 to the number of points.
-    fn span_cuts(&self, size: usize) -> Vec<usize> {
+    pub(super) fn span_cuts(&self, size: usize) -> Vec<usize> {
         let n = self.first.len();
         let mut cuts = vec![0];
         let mut at = size;

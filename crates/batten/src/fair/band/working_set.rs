@@ -34,6 +34,8 @@ use super::design::{Design, SplineMap};
 use super::energy::{Energy, Window};
 use super::solver::{Problem, Solution, solve_all, solve_all_checked};
 use crate::error::Result;
+use crate::numeric::PARALLEL_FROM;
+use rayon::prelude::*;
 
 /// Points farther than this from the reference (in tolerances) start in the working set.
 const SELECT: f64 = 0.8;
@@ -50,6 +52,8 @@ const RESTART_RADIUS: f64 = 0.95;
 /// of 260–1 900) would sweep its million points once a round to save iterations that cost
 /// less than that sweep.
 const CHECK_SET_FRACTION: usize = 64;
+/// The least piece of the sweeps over every point that run in parallel.
+const PIECE: usize = 1 << 14;
 /// Rounds before the full problem is solved instead.
 const MAX_ROUNDS: usize = 30;
 /// Pivots of a knot span's data Gram matrix below this fraction of its largest diagonal
@@ -113,8 +117,10 @@ pub(super) fn solve<const D: usize>(
         iterations += sol.iterations;
         p.design
             .residual::<D>(&sol.y, &p.centres, Some(p.pinned), &mut r);
-        let outside =
-            (0..n).any(|i| !in_set[i] && !p.pinned[i] && norm2(&r[i * D..(i + 1) * D]) > 1.0);
+        let outside = (0..n)
+            .into_par_iter()
+            .with_min_len(PIECE)
+            .any(|i| !in_set[i] && !p.pinned[i] && norm2(&r[i * D..(i + 1) * D]) > 1.0);
         if !outside {
             #[cfg(test)]
             let multipliers = {
@@ -200,10 +206,30 @@ fn segment_exit(a: &[f64], d: &[f64], radius2: f64) -> f64 {
 
 /// The first working set: in every run of points on one knot span the point farthest from
 /// the reference (`|c_i|`), and every point farther than [`SELECT`]; pinned points never.
+/// In parallel pieces cut where a knot span begins (each run whole in one piece).
 fn initial_set<const D: usize>(map: &SplineMap, centres: &[f64], pinned: &[bool]) -> Vec<bool> {
     let n = map.first.len();
-    let mut in_set = vec![false; n];
-    let mut i = 0;
+    if n < PARALLEL_FROM {
+        return initial_set_of::<D>(map, centres, pinned, 0..n);
+    }
+    let cuts = map.span_cuts(PIECE);
+    let pieces: Vec<Vec<bool>> = cuts
+        .par_windows(2)
+        .map(|w| initial_set_of::<D>(map, centres, pinned, w[0]..w[1]))
+        .collect();
+    pieces.concat()
+}
+
+/// [`initial_set`] of the points `points` (whole runs), in order.
+fn initial_set_of<const D: usize>(
+    map: &SplineMap,
+    centres: &[f64],
+    pinned: &[bool],
+    points: std::ops::Range<usize>,
+) -> Vec<bool> {
+    let (start, n) = (points.start, points.end);
+    let mut in_set = vec![false; n - start];
+    let mut i = start;
     while i < n {
         let f = map.first[i];
         let mut best: Option<(usize, f64)> = None;
@@ -214,12 +240,12 @@ fn initial_set<const D: usize>(map: &SplineMap, centres: &[f64], pinned: &[bool]
                 if best.is_none_or(|(_, b)| d > b) {
                     best = Some((j, d));
                 }
-                in_set[j] |= d > SELECT * SELECT;
+                in_set[j - start] |= d > SELECT * SELECT;
             }
             j += 1;
         }
         if let Some((k, _)) = best {
-            in_set[k] = true;
+            in_set[k - start] = true;
         }
         i = j;
     }
