@@ -164,18 +164,30 @@ enum Newton {
 }
 
 impl Newton {
-    fn new<const D: usize>(energy: &Energy<D>, held: &[bool]) -> Newton {
+    /// The Newton matrix's energy part, and the largest row sum of `|A|` (of every entry,
+    /// held or not), from one traversal of the energy's entries where the matrix is
+    /// assembled (open): its entries `2A` halved are `A`'s exactly.
+    fn new<const D: usize>(energy: &Energy<D>, held: &[bool]) -> (Newton, f64) {
         // `held` is per unknown.
         let dim = energy.n * D;
         let bw = 4 * D - 1;
+        let mut rows = vec![0.0_f64; dim];
+        let mut add_abs = |r: usize, c: usize, v: f64| {
+            rows[r] += v.abs();
+            if r != c {
+                rows[c] += v.abs();
+            }
+        };
         if energy.closed {
-            return Newton::Closed { work: None };
+            energy.for_each_lower(1.0, add_abs);
+            return (Newton::Closed { work: None }, norm_inf(&rows));
         }
         let mut base = SymBanded::zeros(dim, bw);
         energy.for_each_lower(2.0, |r, c, v| {
             if !held[r / D] && !held[c / D] {
                 base.add(r, c, v);
             }
+            add_abs(r, c, 0.5 * v);
         });
         for (i, _) in held.iter().enumerate().filter(|(_, h)| **h) {
             for a in 0..D {
@@ -183,12 +195,13 @@ impl Newton {
             }
         }
         let work = base.clone();
-        Newton::Open {
+        let newton = Newton::Open {
             base,
             work,
             exact: false,
             plain: !held.iter().any(|h| *h),
-        }
+        };
+        (newton, norm_inf(&rows))
     }
 
     /// `out += A x`: from the assembled band `2A` when it is the energy's own (open, nothing
@@ -631,17 +644,7 @@ impl<'p, 'a, const D: usize> Ipm<'p, 'a, D> {
                 .collect()
         };
         let st = State::<D> { y, off, lam, sig };
-        let newton = Newton::new(energy, held);
-        let a_abs = {
-            let mut rows = vec![0.0_f64; dim];
-            energy.for_each_lower(1.0, |r, c, v| {
-                rows[r] += v.abs();
-                if r != c {
-                    rows[c] += v.abs();
-                }
-            });
-            norm_inf(&rows)
-        };
+        let (newton, a_abs) = Newton::new(energy, held);
         Ok(Ipm {
             p,
             n,
@@ -945,7 +948,6 @@ fn direction<const D: usize>(
     let dy = &mut *step.dy;
     dy.copy_from_slice(rhs);
     newton.solve(dy)?;
-    let rhs_size = norm_inf(rhs).max(f64::MIN_POSITIVE);
     // The spline form's factors without a floored pivot are the matrix's own: no refinement
     // (its check alone, a product with the whole matrix, was a fifth of a direction's time,
     // and on #14's 10⁶-point sine it never refined).
@@ -953,6 +955,11 @@ fn direction<const D: usize>(
         0
     } else {
         MAX_REFINEMENTS
+    };
+    let rhs_size = if refinements > 0 {
+        norm_inf(rhs).max(f64::MIN_POSITIVE)
+    } else {
+        0.0
     };
     for _ in 0..refinements {
         newton_apply(p, blocks, dy, &mut work.points, &mut work.vars);
