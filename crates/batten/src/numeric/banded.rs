@@ -142,6 +142,13 @@ impl SymBanded {
         self.split = None;
     }
 
+    /// Take the matrix as unfactorised, its factors' storage to be set again row by row
+    /// ([`BandRows::assign_from`]) before anything else reads it.
+    pub(crate) fn reassemble(&mut self) {
+        self.factored = false;
+        self.split = None;
+    }
+
     /// The rows `from..to` of the (unfactorised) lower band, to add entries to.
     ///
     /// # Panics
@@ -295,6 +302,25 @@ impl BandRows<'_> {
     #[inline]
     pub(crate) fn holds(&self, i: usize) -> bool {
         i >= self.from && (i - self.from) * self.w < self.band.len()
+    }
+
+    /// Set the rows held to those of `other`, a matrix of the same shape.
+    ///
+    /// # Panics
+    /// If `other`'s shape differs.
+    pub(crate) fn assign_from(&mut self, other: &SymBanded) {
+        assert!(
+            other.bw + 1 == self.w,
+            "BandRows::assign_from shapes differ"
+        );
+        let at = self.from * self.w;
+        self.band
+            .copy_from_slice(&other.band[at..at + self.band.len()]);
+    }
+
+    /// The largest diagonal entry of the rows held, and 0.
+    pub(crate) fn max_diagonal(&self) -> f64 {
+        self.band.iter().step_by(self.w).fold(0.0, |m, v| m.max(*v))
     }
 
     /// Add `v` to `A[i][j]` (`j ≤ i ≤ j + bw`); an entry of a row not held is left out.

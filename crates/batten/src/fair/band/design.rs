@@ -104,28 +104,36 @@ impl SplineMap {
         }
     }
 
-    /// Add `Σ_i B_iᵀ M_i B_i` (`M_i = blocks[i]`, points with `skip[i]` left out, entries of
-    /// `held` unknowns left out) into the lower band of `m`, for an open curve (no control
-    /// point wraps): what [`Design::for_each_block_lower`] reports, added in the same order
-    /// (the same sums, bit for bit), written straight into the band. The interior point
-    /// assembles this at every iteration, and through a callback per entry it was a tenth of
-    /// a dense run's time.
+    /// Set the lower band of `m` to that of `base` plus `Σ_i B_iᵀ M_i B_i` (`M_i =
+    /// blocks[i]`, points with `skip[i]` left out, entries of `held` unknowns left out), for
+    /// an open curve (no control point wraps), and return its largest diagonal entry (or 0):
+    /// what [`Design::for_each_block_lower`] reports, added in the same order (the same sums,
+    /// bit for bit), written straight into the band. The interior point assembles this at
+    /// every iteration, and through a callback per entry it was a tenth of a dense run's
+    /// time; each thread copies and measures its own rows while they are in its cache.
     pub(super) fn add_blocks_open<const D: usize>(
         &self,
         blocks: &[[[f64; D]; D]],
         skip: &[bool],
         held: &[bool],
+        base: &SymBanded,
         m: &mut SymBanded,
-    ) {
+    ) -> f64 {
         let n = blocks.len();
         let cut = if n >= SPLIT_ASSEMBLY_FROM {
             self.first[n / 2]
         } else {
             0
         };
+        // Every row is set from `base` below: the last factors are overwritten.
+        m.reassemble();
+        let rows = |points: std::ops::Range<usize>, mut rows: BandRows<'_>| {
+            rows.assign_from(base);
+            self.add_blocks_rows::<D>(blocks, skip, held, points, &mut rows);
+            rows.max_diagonal()
+        };
         if cut < 4 {
-            self.add_blocks_rows::<D>(blocks, skip, held, 0..n, m.rows_mut(0, m.n()));
-            return;
+            return rows(0..n, m.rows_mut(0, m.n()));
         }
         // Two threads, each writing the rows it owns: the first the rows of control points
         // before `cut` (from the spans before it), the second the others (from the spans
@@ -133,10 +141,11 @@ impl SplineMap {
         // order as one sweep: the same sums, bit for bit.
         let from = |span: usize| self.first[..n].partition_point(|&f| f < span);
         let (top, bottom) = m.split_rows_mut(cut * D);
-        rayon::join(
-            || self.add_blocks_rows::<D>(blocks, skip, held, 0..from(cut), top),
-            || self.add_blocks_rows::<D>(blocks, skip, held, from(cut - 3)..n, bottom),
+        let (a, b) = rayon::join(
+            || rows(0..from(cut), top),
+            || rows(from(cut - 3)..n, bottom),
         );
+        a.max(b)
     }
 
     /// [`SplineMap::add_blocks_open`] for the points `points`, into the rows `rows` holds
@@ -147,7 +156,7 @@ impl SplineMap {
         skip: &[bool],
         held: &[bool],
         points: std::ops::Range<usize>,
-        mut rows: BandRows<'_>,
+        rows: &mut BandRows<'_>,
     ) {
         let mut acc = [[[[0.0; D]; D]; 4]; 4];
         let flush = |f: usize, acc: &mut [[[[f64; D]; D]; 4]; 4], m: &mut BandRows<'_>| {
@@ -182,7 +191,7 @@ impl SplineMap {
             let (f, b, mb) = (self.first[i], &self.basis[i], &blocks[i]);
             if current != Some(f) {
                 if let Some(g) = current {
-                    flush(g, &mut acc, &mut rows);
+                    flush(g, &mut acc, rows);
                 }
                 current = Some(f);
             }
@@ -198,7 +207,7 @@ impl SplineMap {
             }
         }
         if let Some(g) = current {
-            flush(g, &mut acc, &mut rows);
+            flush(g, &mut acc, rows);
         }
     }
 
@@ -595,18 +604,38 @@ pub(super) mod tests {
             let held: Vec<bool> = (0..vars)
                 .map(|j| held_ends && (j < ends || j + ends >= vars))
                 .collect();
-            let mut want = SymBanded::zeros(dim, 7);
+            // A base with entries in every stored place, which the blocks are added to
+            // (diagonally dominant, so that the sum can be factorised).
+            let mut base = SymBanded::zeros(dim, 7);
+            for r in 0..dim {
+                for c in r.saturating_sub(7)..=r {
+                    base.add(r, c, 0.1 + (r as f64 * 0.7 + c as f64).sin());
+                }
+                base.add(r, r, 20.0);
+            }
+            let mut want = base.clone();
             design.for_each_block_lower::<2>(&blocks, skip, |r, c, v| {
                 if !held[r / 2] && !held[c / 2] {
                     want.add(r, c, v);
                 }
             });
+            // Whatever the matrix held before is replaced.
             let mut got = SymBanded::zeros(dim, 7);
-            map.add_blocks_open::<2>(&blocks, skip, &held, &mut got);
-            for r in 0..dim {
-                for c in r.saturating_sub(7)..=r {
-                    assert_eq!(got.get(r, c).to_bits(), want.get(r, c).to_bits(), "{r} {c}");
+            got.add(3, 2, 7.0);
+            // Again into the factors of the first (the interior point's every iteration).
+            for again in [false, true] {
+                if again {
+                    got.factorize_regularized_split(1e-12).expect("factors");
                 }
+                let top = map.add_blocks_open::<2>(&blocks, skip, &held, &base, &mut got);
+                for r in 0..dim {
+                    for c in r.saturating_sub(7)..=r {
+                        let (g, w) = (got.get(r, c), want.get(r, c));
+                        assert_eq!(g.to_bits(), w.to_bits(), "{r} {c}");
+                    }
+                }
+                let want_top = (0..dim).fold(0.0_f64, |m, k| m.max(want.get(k, k)));
+                assert_eq!(top.to_bits(), want_top.to_bits());
             }
         }
     }

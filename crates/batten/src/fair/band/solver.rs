@@ -227,24 +227,25 @@ impl Newton {
             Newton::Open {
                 base, work, exact, ..
             } => {
-                work.assign(base);
-                let mut top = 0.0_f64;
-                match p.design {
+                let top = match p.design {
                     Design::Spline(map) => {
-                        map.add_blocks_open::<D>(blocks, p.pinned, held, work);
+                        map.add_blocks_open::<D>(blocks, p.pinned, held, base, work)
                     }
                     Design::Points { .. } => {
+                        work.assign(base);
                         p.design
                             .for_each_block_lower::<D>(blocks, p.pinned, |r, c, v| {
                                 if !held[r / D] && !held[c / D] {
                                     work.add(r, c, v);
                                 }
                             });
+                        let mut top = 0.0_f64;
+                        for k in 0..work.n() {
+                            top = top.max(work.get(k, k));
+                        }
+                        top
                     }
-                }
-                for k in 0..work.n() {
-                    top = top.max(work.get(k, k));
-                }
+                };
                 *exact = work.factorize_regularized_split(REGULARIZATION_REL * top)? == 0;
             }
             Newton::Closed { work } => {
