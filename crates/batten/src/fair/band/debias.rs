@@ -625,20 +625,29 @@ fn smooth_log_weights(weights: &[f64], unit: f64, closed: bool, lengths: f64) ->
     if n == 0 {
         return Vec::new();
     }
-    // Prefix sums of the logarithms three times over, so that cyclic windows are plain
-    // ranges (each logarithm taken once).
     // The weights come in runs of equal values: each run's logarithm and window taken once.
     let logs: Vec<f64> = per_run(weights, |w| w.ln());
+    let reach = (n / 2).max(1);
     let halves: Vec<usize> = per_run(weights, |w| {
         let length = lengths * (w / unit).powf(-1.0 / 6.0);
-        ((0.5 * length).round() as usize).clamp(1, (n / 2).max(1))
+        ((0.5 * length).round() as usize).clamp(1, reach)
     });
-    let mut prefix = Vec::with_capacity(3 * n + 1);
-    prefix.push(0.0);
+    // Prefix sums of the logarithms three times over, so that cyclic windows are plain
+    // ranges (each logarithm taken once), kept from `from` to `to` only, where the windows
+    // read them: the middle copy for an open curve, half a copy more on each side for a
+    // closed one (the sums themselves run from the start, so they are the same numbers).
+    let reach = if closed { reach } else { 0 };
+    let (from, to) = (n - reach, 2 * n + reach);
+    let mut prefix = Vec::with_capacity(to - from + 1);
+    if from == 0 {
+        prefix.push(0.0);
+    }
     let mut acc = 0.0;
-    for l in logs.iter().chain(&logs).chain(&logs) {
+    for (k, l) in logs.iter().chain(&logs).chain(&logs).take(to).enumerate() {
         acc += l;
-        prefix.push(acc);
+        if k + 1 >= from {
+            prefix.push(acc);
+        }
     }
     map_indices(n, |i| {
         let half = halves[i];
@@ -647,7 +656,7 @@ fn smooth_log_weights(weights: &[f64], unit: f64, closed: bool, lengths: f64) ->
         } else {
             (n + i.saturating_sub(half), n + (i + half + 1).min(n))
         };
-        ((prefix[hi] - prefix[lo]) / (hi - lo) as f64).exp()
+        ((prefix[hi - from] - prefix[lo - from]) / (hi - lo) as f64).exp()
     })
 }
 
@@ -1118,6 +1127,53 @@ mod tests {
         // Across the seam (point 199, high, next to point 0, low) the ramp goes the other way.
         assert!(closed[0] > low * 1.01 && closed[199] < high * 0.99);
         assert_eq!(&closed[20..80], &open[20..80]);
+    }
+
+    /// The smoothed weights are those of the prefix sums over all three copies kept whole
+    /// (the first version), bit for bit: short curves, where a window reaches every copy, and
+    /// a long one.
+    #[test]
+    fn smoothing_keeps_only_the_sums_it_reads() {
+        fn whole(weights: &[f64], unit: f64, closed: bool, lengths: f64) -> Vec<f64> {
+            let n = weights.len();
+            let logs: Vec<f64> = weights.iter().map(|w| w.ln()).collect();
+            let mut prefix = vec![0.0];
+            let mut acc = 0.0;
+            for l in logs.iter().chain(&logs).chain(&logs) {
+                acc += l;
+                prefix.push(acc);
+            }
+            (0..n)
+                .map(|i| {
+                    let length = lengths * (weights[i] / unit).powf(-1.0 / 6.0);
+                    let half = ((0.5 * length).round() as usize).clamp(1, (n / 2).max(1));
+                    let (lo, hi) = if closed {
+                        (n + i - half, n + i + half + 1)
+                    } else {
+                        (n + i.saturating_sub(half), n + (i + half + 1).min(n))
+                    };
+                    ((prefix[hi] - prefix[lo]) / (hi - lo) as f64).exp()
+                })
+                .collect()
+        }
+        for n in [1, 2, 3, 7, 40, PARALLEL_FROM + 777] {
+            // Runs of equal weights.
+            let weights: Vec<f64> = (0..n)
+                .map(|i| 1e-6 * 4f64.powi(((i / 1000 + i / 7) % 4) as i32))
+                .collect();
+            for closed in [false, true] {
+                let got = smooth_log_weights(&weights, 1.0, closed, WEIGHT_SMOOTHING);
+                let want = whole(&weights, 1.0, closed, WEIGHT_SMOOTHING);
+                assert_eq!(got.len(), n);
+                for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+                    assert_eq!(
+                        g.to_bits(),
+                        w.to_bits(),
+                        "n {n}, closed {closed}, point {i}"
+                    );
+                }
+            }
+        }
     }
 
     /// The window about `i` by brute force: indices `i − half ..= i + half`, wrapped when
