@@ -5,9 +5,10 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::count_sign_changes;
-use super::space_curve::{Frenet, SpaceCubic, SpaceDerivatives, norm};
+use super::space_curve::{Frenet, SpaceCubic, SpaceDerivatives};
 use crate::error::Result;
 use crate::geom::SpaceSeq;
+use crate::geom::norm3 as norm;
 use crate::numeric::GaussLegendre;
 
 /// Rounding-noise factor of the sign tests, as for planar curves: κ below

@@ -8,7 +8,7 @@
 use std::ops::{Add, Div, Mul, Sub};
 
 use crate::error::{Error, Result};
-use crate::geom::{SpaceSeq, Xyz};
+use crate::geom::{SpaceSeq, Xyz, norm3 as norm};
 use crate::numeric::{GaussLegendre, Linear};
 use crate::spline::{Ends, break_span, hermite_coeffs, open_tangents, periodic_tangents};
 
@@ -64,12 +64,6 @@ pub(crate) fn cross(a: Xyz, b: Xyz) -> Xyz {
         a[2] * b[0] - a[0] * b[2],
         a[0] * b[1] - a[1] * b[0],
     ]
-}
-
-/// `|a|`, without overflow for finite components.
-#[inline]
-pub(crate) fn norm(a: Xyz) -> f64 {
-    a[0].hypot(a[1]).hypot(a[2])
 }
 
 /// Position and the first three derivatives with respect to the spline parameter at one

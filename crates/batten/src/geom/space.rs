@@ -102,7 +102,9 @@ pub(crate) fn sub(a: Xyz, b: Xyz) -> Xyz {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
-/// The Euclidean length of `v`, without overflow for finite components.
+/// The Euclidean length of `v`, without overflow for finite components (`hypot`: the space
+/// analysis and fair measure lengths by it, bit for bit).
+#[inline]
 pub(crate) fn norm(v: Xyz) -> f64 {
     v[0].hypot(v[1]).hypot(v[2])
 }
