@@ -127,9 +127,19 @@ impl<'a, const D: usize> Penalized<'a, D> {
         let mut coupling = vec![0.0; dim];
         energy.apply_add(&fixed, &mut coupling);
         let bw = 4 * D - 1;
+        // The matrix and its largest diagonal entry in one traversal of the energy's entries.
+        let mut top = 0.0_f64;
+        let mut diagonal = |r: usize, c: usize, v: f64| {
+            if r == c {
+                top = top.max(v.abs());
+            }
+        };
         let base = if energy.closed {
             let mut m = CyclicSymBanded::zeros(dim, bw);
-            energy.for_each_lower(2.0, |r, c, v| m.add(r, c, v));
+            energy.for_each_lower(2.0, |r, c, v| {
+                m.add(r, c, v);
+                diagonal(r, c, v);
+            });
             Base::Closed(m)
         } else {
             let mut m = SymBanded::zeros(dim, bw);
@@ -137,18 +147,13 @@ impl<'a, const D: usize> Penalized<'a, D> {
                 if !held[r / D] && !held[c / D] {
                     m.add(r, c, v);
                 }
+                diagonal(r, c, v);
             });
             for k in (0..dim).filter(|k| held[k / D]) {
                 m.add(k, k, 1.0);
             }
             Base::Open(m)
         };
-        let mut top = 0.0_f64;
-        energy.for_each_lower(2.0, |r, c, v| {
-            if r == c {
-                top = top.max(v.abs());
-            }
-        });
         // The data term's parts that do not depend on the weights: in the spline form from
         // the knot spans' sums (one sweep over the points), in the point form per point.
         let (gram, pull, sums) = match design {
