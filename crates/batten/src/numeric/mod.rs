@@ -27,7 +27,9 @@ pub use cyclic_banded::CyclicSymBanded;
 pub use minimize::{Minimum, minimize_brent, minimize_golden};
 pub use nelder_mead::{NelderMeadParams, SimplexMinimum, minimize_nelder_mead};
 pub(crate) use norm::norm;
-pub(crate) use parallel::{PARALLEL_FROM, beside_in_background, map_indices, max_indices};
+pub(crate) use parallel::{
+    PARALLEL_FROM, beside_in_background, map_indices, map_pieces, max_indices,
+};
 pub use quadrature::GaussLegendre;
 pub use tridiagonal::{solve_cyclic_tridiagonal, solve_tridiagonal};
 

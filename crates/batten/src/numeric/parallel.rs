@@ -20,6 +20,24 @@ pub(crate) fn map_indices<T: Send>(count: usize, f: impl Fn(usize) -> T + Sync +
     }
 }
 
+/// `f` of the pieces `0..piece`, `piece..2·piece`, … of `0..count` (the last one shorter), in
+/// order, in parallel from [`PARALLEL_FROM`] elements on: for sweeps whose pieces each
+/// gather a few results, joined afterwards in order.
+pub(crate) fn map_pieces<T: Send>(
+    count: usize,
+    piece: usize,
+    f: impl Fn(std::ops::Range<usize>) -> T + Sync + Send,
+) -> Vec<T> {
+    use rayon::prelude::*;
+    let at = |c: usize| f(c * piece..((c + 1) * piece).min(count));
+    let pieces = count.div_ceil(piece);
+    if count >= PARALLEL_FROM {
+        (0..pieces).into_par_iter().map(at).collect()
+    } else {
+        (0..pieces).map(at).collect()
+    }
+}
+
 /// The largest of `f(0), …, f(count − 1)` and 0 (NaNs ignored), in parallel from
 /// [`PARALLEL_FROM`] elements on (in pieces of at least `piece`): the largest is the same in
 /// any order, so the same with any number of threads.

@@ -23,7 +23,7 @@
 use super::design::{Design, SplineMap};
 use super::energy::{Energy, four_from};
 use crate::error::Result;
-use crate::numeric::{Bracket, CyclicSymBanded, PARALLEL_FROM, SymBanded, map_indices};
+use crate::numeric::{Bracket, CyclicSymBanded, PARALLEL_FROM, SymBanded, map_indices, map_pieces};
 use rayon::prelude::*;
 
 /// Points a task of [`Windows::significant`] scans.
@@ -416,11 +416,10 @@ impl<'a, const D: usize> Penalized<'a, D> {
     /// two thirds of a round).
     pub(super) fn far_points(&self, y: &[f64], radius: f64) -> (f64, Vec<(usize, f64)>) {
         let (pinned, centres) = (self.pinned, self.centres);
-        let n = self.points();
-        let piece = |c: usize| {
+        let parts = map_pieces(self.points(), FAR_PIECE, |points| {
             let mut farthest = 0.0_f64;
             let mut far = Vec::new();
-            for i in c * FAR_PIECE..((c + 1) * FAR_PIECE).min(n) {
+            for i in points {
                 if pinned[i] {
                     continue;
                 }
@@ -438,13 +437,7 @@ impl<'a, const D: usize> Penalized<'a, D> {
                 }
             }
             (farthest, far)
-        };
-        let pieces = n.div_ceil(FAR_PIECE);
-        let parts: Vec<(f64, Vec<(usize, f64)>)> = if n >= PARALLEL_FROM {
-            (0..pieces).into_par_iter().map(piece).collect()
-        } else {
-            (0..pieces).map(piece).collect()
-        };
+        });
         let farthest = parts.iter().fold(0.0_f64, |m, (f, _)| m.max(*f));
         (
             farthest,
@@ -641,8 +634,8 @@ fn smooth_log_weights(weights: &[f64], unit: f64, closed: bool, lengths: f64) ->
     // ranges (each logarithm taken once), kept from `from` to `to` only, where the windows
     // read them: the middle copy for an open curve, half a copy more on each side for a
     // closed one (the sums themselves run from the start, so they are the same numbers).
-    let reach = if closed { reach } else { 0 };
-    let (from, to) = (n - reach, 2 * n + reach);
+    let beyond = if closed { reach } else { 0 };
+    let (from, to) = (n - beyond, 2 * n + beyond);
     let mut prefix = Vec::with_capacity(to - from + 1);
     if from == 0 {
         prefix.push(0.0);

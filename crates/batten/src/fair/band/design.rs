@@ -127,13 +127,13 @@ impl SplineMap {
         };
         // Every row is set from `base` below: the last factors are overwritten.
         m.reassemble();
-        let rows = |points: std::ops::Range<usize>, mut rows: BandRows<'_>| {
+        let assemble = |points: std::ops::Range<usize>, mut rows: BandRows<'_>| {
             rows.assign_from(base);
             self.add_blocks_rows::<D>(blocks, skip, held, points, &mut rows);
             rows.max_diagonal()
         };
         if cut < 4 {
-            return rows(0..n, m.rows_mut(0, m.n()));
+            return assemble(0..n, m.rows_mut(0, m.n()));
         }
         // Two threads, each writing the rows it owns: the first the rows of control points
         // before `cut` (from the spans before it), the second the others (from the spans
@@ -142,8 +142,8 @@ impl SplineMap {
         let from = |span: usize| self.first[..n].partition_point(|&f| f < span);
         let (top, bottom) = m.split_rows_mut(cut * D);
         let (a, b) = rayon::join(
-            || rows(0..from(cut), top),
-            || rows(from(cut - 3)..n, bottom),
+            || assemble(0..from(cut), top),
+            || assemble(from(cut - 3)..n, bottom),
         );
         a.max(b)
     }

@@ -69,8 +69,7 @@ use crate::fair::{
     SolverInfo, SpaceOutcome,
 };
 use crate::geom::{Point, PointSeq, SpaceSeq};
-use crate::numeric::{PARALLEL_FROM, map_indices};
-use rayon::prelude::*;
+use crate::numeric::{map_indices, map_pieces};
 
 use debias::{ENERGY_CAP, Penalized};
 use energy::{Energy, Metric};
@@ -561,10 +560,10 @@ fn band_problem<'a, const D: usize>(
 /// overall largest. The same candidates, so the same number, in any number of pieces.
 fn farthest<const D: usize>(pts: &[[f64; D]], r: &[f64], tolerance: f64) -> f64 {
     const NEAR: f64 = 1.0 - 1e-12;
-    let piece = |c: usize| {
+    let parts = map_pieces(pts.len(), FARTHEST_PIECE, |points| {
         let mut top = 0.0_f64;
         let mut measured = Vec::new();
-        for i in c * FARTHEST_PIECE..((c + 1) * FARTHEST_PIECE).min(pts.len()) {
+        for i in points {
             let (p, q) = (
                 &pts[i],
                 into_band_point(&pts[i], &r[i * D..(i + 1) * D], tolerance),
@@ -576,13 +575,7 @@ fn farthest<const D: usize>(pts: &[[f64; D]], r: &[f64], tolerance: f64) -> f64 
             }
         }
         (top, measured)
-    };
-    let pieces = pts.len().div_ceil(FARTHEST_PIECE);
-    let parts: Vec<(f64, Vec<(f64, f64)>)> = if pts.len() >= PARALLEL_FROM {
-        (0..pieces).into_par_iter().map(piece).collect()
-    } else {
-        (0..pieces).map(piece).collect()
-    };
+    });
     let near = parts.iter().fold(0.0_f64, |m, (top, _)| m.max(*top)) * NEAR;
     parts
         .iter()

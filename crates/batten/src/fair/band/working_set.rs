@@ -107,11 +107,13 @@ pub(super) fn solve<const D: usize>(
         // replaces. The check sweeps every point, so only a set of at least
         // 1/[`CHECK_SET_FRACTION`] of them, whose iterations cost more, is checked.
         let check = set.len() * CHECK_SET_FRACTION >= n;
+        // Point `i`, residual `ri`, is outside the set and outside its ball.
+        let escaped = |i: usize, ri: &[f64]| !in_set[i] && !p.pinned[i] && norm2(ri) > 1.0;
         let sol = solve_all_checked(&sub, |y| {
             check
                 && p.design.any_point::<D>(y, |i, q| {
-                    let r: [f64; D] = std::array::from_fn(|a| q[a] - p.centres[i * D + a]);
-                    !in_set[i] && !p.pinned[i] && norm2(&r) > 1.0
+                    let ri: [f64; D] = std::array::from_fn(|a| q[a] - p.centres[i * D + a]);
+                    escaped(i, &ri)
                 })
         })?;
         iterations += sol.iterations;
@@ -120,7 +122,7 @@ pub(super) fn solve<const D: usize>(
         let outside = (0..n)
             .into_par_iter()
             .with_min_len(PIECE)
-            .any(|i| !in_set[i] && !p.pinned[i] && norm2(&r[i * D..(i + 1) * D]) > 1.0);
+            .any(|i| escaped(i, &r[i * D..(i + 1) * D]));
         if !outside {
             #[cfg(test)]
             let multipliers = {
